@@ -1,0 +1,11 @@
+"""gmsh geometry builders: one function per geometry family, registered by name.
+
+Every builder takes its parameters as keywords (lengths in m, ``h`` the target element size in m),
+writes a MSH 2.2 file (the only version FreeFEM's ``gmshload`` reads) and returns the boundary names
+it labelled. Labels come from :mod:`wendel.meshes.labels`.
+"""
+
+from .builders import BUILDERS, build, Built
+from .labels import LABELS, NAMES
+
+__all__ = ["BUILDERS", "build", "Built", "LABELS", "NAMES"]

@@ -1,0 +1,24 @@
+"""Boundary and domain labels shared by the gmsh builders and the .idp files.
+
+A label number is the gmsh physical tag of a named boundary and the FreeFEM label of the same
+boundary. Scenes name boundaries; the driver turns names into these numbers.
+
+>>> LABELS["top"]
+4
+"""
+
+LABELS = {
+    "left": 1,      # x = x0
+    "right": 2,     # x = x1
+    "bottom": 3,    # y = y0 in 2D, z = z0 in 3D
+    "top": 4,       # y = y1 in 2D, z = z1 in 3D
+    "front": 5,     # y = y0 in 3D
+    "back": 6,      # y = y1 in 3D
+    "inner": 7,     # inner surface of a hollow body
+    "outer": 8,     # outer surface of a hollow body
+    "symmetry_x": 11,  # plane x = 0 of a symmetric model
+    "symmetry_y": 12,  # plane y = 0 of a symmetric model
+    "domain": 100,  # the body itself
+}
+
+NAMES = {number: name for name, number in LABELS.items()}
