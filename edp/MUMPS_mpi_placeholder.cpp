@@ -1,0 +1,3 @@
+#include "ff++.hpp"
+static void Load_Init() {}
+LOADFUNC(Load_Init)
