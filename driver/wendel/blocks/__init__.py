@@ -1,0 +1,58 @@
+"""Registry of optional physics blocks (``[plasticity]``, ``[contact]``, ``[thermal]`` in a scene).
+
+A block module in this package calls :func:`register` with a :class:`Block`: the scene table's
+pydantic model, and the function that turns the validated table into FreeFEM ``-key value`` options.
+A scene composes only the blocks it names; each block adds its tag to the entry script's name
+(``edp/solve-2d-contact-plasticity.edp``), so FreeFEM includes only those modules.
+
+>>> sorted(BLOCKS) == sorted(set(BLOCKS))
+True
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import importlib
+import pkgutil
+from typing import Any, Callable
+
+from pydantic import BaseModel
+
+
+@dataclasses.dataclass(frozen=True)
+class Block:
+    """One optional physics block.
+
+    Attributes
+    ----------
+    name : str
+        Table name in the scene file and tag in the entry script's name.
+    model : type[BaseModel]
+        Schema of the table (every key with type, default, unit and range in its Field).
+    options : callable
+        ``options(block, scene, files) -> list[str]``: FreeFEM options (numbers and integer ids only);
+        ``files`` is a :class:`wendel.run.RunFiles` where a block may write tables it needs.
+    fields : tuple of str
+        Names of the VTU fields the module writes (documentation and tests).
+    """
+
+    name: str
+    model: type[BaseModel]
+    options: Callable[[Any, Any, Any], list[str]]
+    fields: tuple[str, ...] = ()
+
+
+BLOCKS: dict[str, Block] = {}
+
+
+def register(block: Block) -> Block:
+    """Add ``block`` to the registry (called at import time by each block module)."""
+    BLOCKS[block.name] = block
+    return block
+
+
+def load_all() -> dict[str, Block]:
+    """Import every block module of this package (each registers itself) and return the registry."""
+    for info in pkgutil.iter_modules(__path__):
+        importlib.import_module(f"{__name__}.{info.name}")
+    return BLOCKS

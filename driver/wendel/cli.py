@@ -1,0 +1,96 @@
+"""Command line: ``wendel run | study | check | bench``.
+
+Exit codes: 0 done, 1 the run failed (FreeFEM error, no convergence), 2 bad input (scene, options).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from . import __version__
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="wendel", description="Thermo-elastoplastic contact simulations "
+                                     "with FreeFEM and gmsh.")
+    parser.add_argument("--version", action="version", version=f"wendel {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    p = sub.add_parser("run", help="run a scene")
+    p.add_argument("scene", nargs="?", help="scene file (TOML)")
+    p.add_argument("--np", type=int, help="MPI ranks (overrides numerics.ranks; >1 uses ffddm)")
+    p.add_argument("--smoke", action="store_true", help="run at the scene's tiny smoke size")
+    p.add_argument("--out", type=Path, help="run folder (default results/<scene>/<time>)")
+    p.add_argument("--resume", type=Path, metavar="RUN_DIR", help="continue a run from its last checkpoint")
+
+    p = sub.add_parser("study", help="error against run time over refined meshes")
+    p.add_argument("scene")
+    p.add_argument("--levels", type=int, default=3, help="number of meshes (h, h/2, ...)")
+    p.add_argument("--smoke", action="store_true", help="start from the smoke size")
+    p.add_argument("--np", type=int)
+    p.add_argument("--out", type=Path)
+
+    p = sub.add_parser("check", help="validate a scene file without running it")
+    p.add_argument("scene", nargs="+")
+
+    p = sub.add_parser("bench", help="benchmarks; results into results/bench/")
+    p.add_argument("names", nargs="*", help="benchmarks to run (default all)")
+    p.add_argument("--quick", action="store_true", help="small sizes only")
+
+    args = parser.parse_args(argv)
+    from .freefem import FreeFemError, NewtonFailure
+    from .run import StepCutError
+    from .scene import SceneError
+    try:
+        if args.command == "check":
+            from .scene import load
+            for s in args.scene:
+                scene = load(s)
+                print(f"{s}: ok ({scene.description}; blocks: {', '.join(scene.blocks) or 'elastic'})")
+            return 0
+        if args.command == "run":
+            from .run import run
+            if args.resume is None and args.scene is None:
+                parser.error("run needs a scene file or --resume RUN_DIR")
+            root = run(args.scene or "", smoke=args.smoke, ranks=args.np, out=args.out, resume=args.resume)
+            _print_summary(root)
+            return 0
+        if args.command == "study":
+            from .study import study
+            root = study(args.scene, levels=args.levels, smoke=args.smoke, ranks=args.np, out=args.out)
+            print(f"study written to {root}")
+            return 0
+        if args.command == "bench":
+            from .bench import bench
+            root = bench(args.names, quick=args.quick)
+            print(f"benchmarks written to {root}")
+            return 0
+    except SceneError as exc:
+        print(f"wendel: bad scene:\n{exc}", file=sys.stderr)
+        return 2
+    except (FileNotFoundError, ValueError, KeyError) as exc:
+        print(f"wendel: bad input: {exc}", file=sys.stderr)
+        return 2
+    except (FreeFemError, NewtonFailure, StepCutError) as exc:
+        print(f"wendel: run failed: {exc}", file=sys.stderr)
+        return 1
+    return 0
+
+
+def _print_summary(root: Path) -> None:
+    import json
+
+    s = json.loads((root / "summary.json").read_text())
+    last = s["last_increment"]
+    print(f"done: {s['increments']} increments, {s['newton_iterations']} Newton iterations, "
+          f"{s['dofs']} DoFs on {s['ranks']} rank(s), {s['wall_time']:.2f} s "
+          f"(start-up and I/O {100 * (s['share_startup_and_io'] or 0):.0f}%)")
+    if last.get("error_h1", -1) >= 0:
+        print(f"error against the analytic reference: L2 {last['error_l2']:.3e}, H1 {last['error_h1']:.3e}")
+    print(f"results: {root}  (ParaView: {root / 'results.pvd'})")
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,157 @@
+"""Run FreeFEM entry scripts: environment, MPI launch, time limit, log, errors turned into exceptions.
+
+Every launch is ``mpirun -np N FreeFem++-mpi -nw -v 0 edp/<entry>.edp -key value ...`` (one code path
+for 1 and N ranks; 0.16 s start on one rank here). FreeFEM's output goes to a log file; results come
+back as files (the exit code says which file to read), never scraped from stdout except to quote a
+compile or runtime error.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import signal
+import subprocess
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+EDP = ROOT / "edp"
+PLUGINS = ROOT / "build" / "plugins"
+
+EXIT_BAD_OPTION = 3   # edp wrote error.txt (wendelFail)
+EXIT_NEWTON = 4       # edp wrote failed.json (an increment did not converge)
+
+
+class FreeFemError(RuntimeError):
+    """FreeFEM stopped: a compile or runtime error (with file and line), a bad option, or a crash."""
+
+    def __init__(self, message: str, file: str | None = None, line: int | None = None, log: Path | None = None):
+        super().__init__(message)
+        self.file, self.line, self.log = file, line, log
+
+
+class FreeFemTimeout(FreeFemError):
+    """A launch ran past its time limit and was stopped."""
+
+
+class NewtonFailure(RuntimeError):
+    """An increment did not converge; ``record`` is edp's failed.json (increment, load factor, reason)."""
+
+    def __init__(self, record: dict):
+        super().__init__(f"Newton failed at increment {record.get('increment')} "
+                         f"(load factor {record.get('load_factor')}): {record.get('reason', 'no convergence')}")
+        self.record = record
+
+
+@dataclass
+class Launch:
+    """What one launch took: wall time and the command."""
+
+    wall: float
+    command: list[str]
+
+
+def environment() -> dict[str, str]:
+    """The environment FreeFEM needs here (include and plugin paths, MPI as root, single-threaded BLAS)."""
+    env = dict(os.environ)
+    env.update({
+        "FF_INCLUDEPATH": f"/usr/include/freefem++/idp;{EDP}",
+        "FF_LOADPATH": f"{PLUGINS};/usr/lib/freefem++/mpi",
+        "OMPI_ALLOW_RUN_AS_ROOT": "1",
+        "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",
+        "OMPI_MCA_pml": "ob1",
+        "OMPI_MCA_btl": "self,vader",
+        "OMPI_MCA_rmaps_base_oversubscribe": "1",
+        "OPENBLAS_NUM_THREADS": "1",
+        "OMP_NUM_THREADS": "1",
+    })
+    return env
+
+
+_COMPILE = re.compile(r"Error line number (\d+), in file (.*?), before\s+token (.*)")
+_CURRENT = re.compile(r"current line = (\d+)")
+_EXEC = re.compile(r"(Exec error : .*|Compile error : .*|Load error : .*|.*Error.*)")
+
+
+def explain_log(text: str, script: Path) -> tuple[str, str | None, int | None]:
+    """Turn FreeFEM's log into (message, file, line).
+
+    >>> explain_log(" Error line number 2, in file t2.edp, before  token *\\nsyntax error\\n", Path("x.edp"))
+    ('t2.edp:2: syntax error (before token *)', 't2.edp', 2)
+    """
+    m = _COMPILE.search(text)
+    if m:
+        line, file, token = int(m.group(1)), m.group(2).strip(), m.group(3).strip()
+        file = file.split(" in ")[-1] if file.startswith("macro:") else file
+        after = text[m.end():].strip().splitlines()
+        what = after[0].strip() if after else "compile error"
+        return f"{file}:{line}: {what} (before token {token})", file, line
+    m = _CURRENT.search(text)
+    if m:
+        line = int(m.group(1))
+        ex = re.search(r"Exec error : (.*)", text) or re.search(r"(Load error : .*)", text)
+        what = ex.group(1).strip() if ex else text.strip().splitlines()[-1]
+        return f"{script.name} (or a file it includes):{line}: {what}", str(script), line
+    tail = "\n".join(text.strip().splitlines()[-5:])
+    return f"FreeFEM stopped without a located error; log tail:\n{tail}", None, None
+
+
+def run(entry: str, options: list[str], out_dir: Path, ranks: int = 1, timeout: float = 3600.0,
+        log: Path | None = None) -> Launch:
+    """Run ``edp/<entry>`` with ``options`` on ``ranks`` MPI ranks; output files go to ``out_dir``.
+
+    Raises :class:`FreeFemError` (with .file and .line), :class:`FreeFemTimeout` or
+    :class:`NewtonFailure`.
+    """
+    script = EDP / entry
+    if not script.is_file():
+        raise FreeFemError(f"no entry script {script}")
+    out_dir.mkdir(parents=True, exist_ok=True)
+    log = log or out_dir / "freefem.log"
+    for stale in ("error.txt", "failed.json"):
+        (out_dir / stale).unlink(missing_ok=True)
+    cmd = ["mpirun", "-np", str(ranks), "FreeFem++-mpi", "-nw", "-v", "0", str(script),
+           "-out", str(out_dir), *options]
+    t0 = time.perf_counter()
+    with open(log, "a") as flog:
+        flog.write("$ " + " ".join(cmd) + "\n")
+        flog.flush()
+        proc = subprocess.Popen(cmd, stdout=flog, stderr=subprocess.STDOUT, env=environment(),
+                                start_new_session=True, cwd=out_dir)
+        try:
+            rc = proc.wait(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            _kill(proc)
+            raise FreeFemTimeout(f"{entry}: stopped after the time limit of {timeout:g} s (numerics.timeout)",
+                                 str(script), None, log) from None
+        except BaseException:
+            _kill(proc)
+            raise
+    wall = time.perf_counter() - t0
+    if rc == 0:
+        return Launch(wall, cmd)
+    if rc == EXIT_NEWTON and (out_dir / "failed.json").is_file():
+        raise NewtonFailure(json.loads((out_dir / "failed.json").read_text()))
+    if (out_dir / "error.txt").is_file():
+        raise FreeFemError((out_dir / "error.txt").read_text().strip(), str(script), None, log)
+    text = log.read_text(errors="replace")
+    text = text[text.rfind("$ mpirun"):]
+    message, file, line = explain_log(text, script)
+    raise FreeFemError(f"FreeFEM error (exit code {rc}) in {message}\n(full log: {log})", file, line, log)
+
+
+def _kill(proc: subprocess.Popen) -> None:
+    """Stop mpirun and its ranks (the whole process group)."""
+    for sig in (signal.SIGTERM, signal.SIGKILL):
+        try:
+            os.killpg(proc.pid, sig)
+        except ProcessLookupError:
+            return
+        try:
+            proc.wait(timeout=3)
+            return
+        except subprocess.TimeoutExpired:
+            continue

@@ -1,0 +1,320 @@
+"""Run a scene: build the mesh, step the load, cut steps that fail, write results, report.
+
+:func:`run` is the table of contents; each step is a small function below it.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import os
+import shutil
+import threading
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from . import freefem, output, report
+from .blocks import BLOCKS
+from .meshes import LABELS, build as build_mesh
+from .schema import ANALYTIC_REFERENCES, BODY_FORCES, Scene
+from .scene import load
+
+RESULTS = freefem.ROOT / "results"
+
+
+class StepCutError(RuntimeError):
+    """An increment failed after every allowed step cut; accepted increments are on disk."""
+
+
+@dataclass
+class RunFiles:
+    """The folders and files of one run."""
+
+    root: Path
+
+    @property
+    def fem(self) -> Path:
+        return self.root / "fem"
+
+    @property
+    def tables(self) -> Path:
+        return self.root / "tables"
+
+    @property
+    def vtu(self) -> Path:
+        return self.root / "vtu"
+
+    @property
+    def mesh(self) -> Path:
+        return self.root / "mesh.msh"
+
+    @property
+    def checkpoint(self) -> Path:
+        return self.root / "checkpoint.json"
+
+
+@dataclass
+class State:
+    """Where the run stands: accepted increments (number, load factor) and what is left to do."""
+
+    accepted: list[tuple[int, float]] = field(default_factory=list)
+    pending: list[float] = field(default_factory=list)
+    cuts: int = 0
+    launches: list[dict] = field(default_factory=list)
+    mesh_seconds: float = 0.0
+    post_seconds: float = 0.0
+
+    @property
+    def last(self) -> tuple[int, float]:
+        return self.accepted[-1] if self.accepted else (0, 0.0)
+
+
+def run(scene_path: str | Path, smoke: bool = False, ranks: int | None = None, out: Path | None = None,
+        resume: Path | None = None, progress=print) -> Path:
+    """Run the scene file ``scene_path``; return the run folder (results/<scene>/<run-id>/)."""
+    scene_path = Path(scene_path)
+    if resume is not None:
+        files, scene, state = _resume(Path(resume))
+        progress(f"resuming {files.root} after increment {state.last[0]} (load factor {state.last[1]:g})")
+    else:
+        scene = load(scene_path, smoke=smoke)
+        if ranks is not None:
+            scene.numerics.ranks = ranks
+            if ranks > 1:
+                scene.numerics.solver = "ffddm"
+        files = RunFiles(Path(out) if out else _new_run_dir(scene_path, smoke))
+        files.root.mkdir(parents=True, exist_ok=True)
+        report.write_provenance(files.root, scene_path, scene, smoke)
+        state = State(pending=scene.loading.load_factors())
+        state.mesh_seconds, dimension = build(scene, files)
+        _save_checkpoint(files, scene, state, dimension)
+    dimension = json.loads(files.checkpoint.read_text())["dimension"]
+    progress(f"wendel: {scene.description}")
+    progress(f"  run folder {files.root}")
+    try:
+        solve(scene, files, state, dimension, progress)
+    finally:
+        report.write_summary(files.root, scene, state, dimension)
+    if scene.output.png and state.accepted:
+        t0 = time.perf_counter()
+        last = files.vtu / f"inc-{state.last[0]:04d}.vtu"
+        output.picture(last, files.root / "deformed.png", f"{scene_path.stem}: load factor {state.last[1]:g}",
+                       scene.output.warp)
+        state.post_seconds += time.perf_counter() - t0
+        report.write_summary(files.root, scene, state, dimension)
+    return files.root
+
+
+def build(scene: Scene, files: RunFiles) -> tuple[float, int]:
+    """Make the mesh (gmsh builder or a given file); return (seconds, dimension)."""
+    t0 = time.perf_counter()
+    g = scene.geometry
+    if g.builder:
+        built = build_mesh(g.builder, files.mesh, **g.params)
+        dimension = built.dimension
+    else:
+        shutil.copyfile(g.mesh, files.mesh)
+        dimension = g.dimension
+    return time.perf_counter() - t0, dimension
+
+
+def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress) -> None:
+    """Launch FreeFEM on the pending increments; on a Newton failure halve the step and go on."""
+    write_tables(scene, files, dimension)
+    entry = entry_script(scene, dimension)
+    while state.pending:
+        inc0 = state.last[0] + 1
+        loads = files.tables / "loads.txt"
+        loads.write_text(f"{len(state.pending)}\n" + "".join(f"{lf!r}\n" for lf in state.pending))
+        opts = options(scene, files, dimension) + ["-loads", str(loads), "-inc0", str(inc0)]
+        if state.accepted:
+            opts += ["-restart", str(files.fem / f"inc-{state.last[0]:04d}")]
+        watcher = _Progress(files.fem, inc0, len(state.pending), state.pending, progress)
+        failure = None
+        try:
+            with watcher:
+                launch = freefem.run(entry, opts, files.fem, ranks=scene.numerics.ranks,
+                                     timeout=scene.numerics.timeout, log=files.root / "freefem.log")
+            state.launches.append({"wall": launch.wall, "increments": len(state.pending)})
+        except freefem.NewtonFailure as exc:
+            failure = exc
+            state.launches.append({"wall": time.perf_counter() - watcher.t0, "increments": None})
+        finally:
+            accept(scene, files, state, dimension)
+        if failure is None:
+            break
+        cut_step(scene, files, state, failure, progress)
+        _save_checkpoint(files, scene, state, dimension)
+
+
+def accept(scene: Scene, files: RunFiles, state: State, dimension: int) -> None:
+    """Take the committed increments FreeFEM wrote: VTU, histories, checkpoint."""
+    t0 = time.perf_counter()
+    points = cells = None
+    while state.pending:
+        inc = state.last[0] + 1
+        d = files.fem / f"inc-{inc:04d}"
+        if not (d / "done").is_file():
+            break
+        record = json.loads((d / "record.json").read_text())
+        if scene.output.vtu:
+            if points is None:
+                points, cells = output.read_mesh(files.mesh, dimension)
+                output.check_node_order(files.fem / "vertices.txt", points)
+            pdata, cdata = output.increment_fields(d, len(points), len(cells), dimension)
+            files.vtu.mkdir(exist_ok=True)
+            output.write_vtu(files.vtu / f"inc-{inc:04d}.vtu", points, cells, dimension, pdata, cdata)
+        state.accepted.append((inc, record["load_factor"]))
+        state.pending.pop(0)
+        report.append_history(files.root, record, d / "newton.csv")
+        _save_checkpoint(files, scene, state, dimension)
+    if scene.output.vtu and state.accepted:
+        output.write_pvd(files.root / "results.pvd",
+                         [(lf, f"vtu/inc-{i:04d}.vtu") for i, lf in state.accepted])
+    state.post_seconds += time.perf_counter() - t0
+
+
+def cut_step(scene: Scene, files: RunFiles, state: State, failure: freefem.NewtonFailure, progress) -> None:
+    """Halve the failed increment, or stop with a clear message when no cut is left."""
+    rec = failure.record
+    inc = state.last[0] + 1
+    failed = files.fem / f"inc-{inc:04d}"
+    if failed.is_dir():
+        keep = files.root / "failed-attempts"
+        keep.mkdir(exist_ok=True)
+        if (failed / "newton.csv").is_file():
+            shutil.copyfile(failed / "newton.csv", keep / f"inc-{inc:04d}-lf-{rec['load_factor']:.6g}-newton.csv")
+        shutil.rmtree(failed)
+    reason = rec.get("reason", "Newton did not converge")
+    lf_prev, lf_fail = state.last[1], state.pending[0]
+    state.cuts += 1
+    mid = lf_prev + 0.5 * (lf_fail - lf_prev)
+    targets = scene.loading.load_factors()
+    nominal = min(abs(b - a) for a, b in zip([0.0] + targets[:-1], targets)) or 1.0
+    smallest = nominal / 2 ** scene.loading.max_cuts
+    if reason == "limit load reached" or abs(mid - lf_prev) < smallest * (1 - 1e-9):
+        what = "limit load reached" if reason == "limit load reached" else \
+            f"{reason}, even after {scene.loading.max_cuts} step halvings (loading.max_cuts)"
+        raise StepCutError(
+            f"increment {inc} (load factor {lf_prev:g} -> {lf_fail:g}): {what}; "
+            f"{len(state.accepted)} accepted increments are kept in {files.root}")
+    state.pending.insert(0, mid)
+    progress(f"  increment {inc}: {reason} at load factor {lf_fail:g}; cutting the step to {mid:g}")
+
+
+def entry_script(scene: Scene, dimension: int) -> str:
+    """The entry script that includes exactly the scene's physics modules."""
+    tags = "".join(f"-{b}" for b in scene.blocks)
+    return f"solve-{dimension}d{tags}.edp"
+
+
+def options(scene: Scene, files: RunFiles, dimension: int) -> list[str]:
+    """FreeFEM options of the scene: numbers and integer ids only."""
+    m, n = scene.material, scene.numerics
+    opts = ["-mesh", str(files.mesh), "-mat_E", repr(m.E), "-mat_nu", repr(m.nu),
+            "-el_plane_stress", "1" if scene.elasticity.plane == "stress" else "0",
+            "-solver", n.solver, "-solver_tol", repr(n.solver_tol),
+            "-newton_tol", repr(n.newton_tol), "-newton_maxit", str(n.newton_maxit),
+            "-bc", str(files.tables / "bc.txt"), "-trac", str(files.tables / "trac.txt")]
+    bf = scene.body_force
+    v = list(bf.value) + [0.0] * (3 - len(bf.value))
+    opts += ["-body_id", str(BODY_FORCES[bf.kind]), "-body_fx", repr(v[0]), "-body_fy", repr(v[1]),
+             "-body_fz", repr(v[2])]
+    if scene.reference.analytic:
+        opts += ["-ref_id", str(ANALYTIC_REFERENCES[scene.reference.analytic])]
+    for name in scene.blocks:
+        opts += BLOCKS[name].options(getattr(scene, name), scene, files)
+    return opts
+
+
+def write_tables(scene: Scene, files: RunFiles, dimension: int) -> None:
+    """Boundary condition tables for bc.idp (labels from meshes/labels.py)."""
+    files.tables.mkdir(parents=True, exist_ok=True)
+    dirichlet, neumann = [], []
+    for name, b in scene.boundary.items():
+        lab = LABELS[name]
+        for comp, val in enumerate((b.ux, b.uy, b.uz)):
+            if val is not None:
+                if comp == 2 and dimension == 2:
+                    raise ValueError(f"boundary.{name}.uz: a 2D scene has no z component")
+                dirichlet.append(f"{lab} {comp} {val!r}")
+        if b.traction is not None or b.pressure is not None:
+            t = list(b.traction or [0.0, 0.0]) + [0.0] * 3
+            neumann.append(f"{lab} {t[0]!r} {t[1]!r} {t[2]!r} {float(b.pressure or 0.0)!r}")
+    (files.tables / "bc.txt").write_text(f"{len(dirichlet)}\n" + "".join(r + "\n" for r in dirichlet))
+    (files.tables / "trac.txt").write_text(f"{len(neumann)}\n" + "".join(r + "\n" for r in neumann))
+
+
+def _new_run_dir(scene_path: Path, smoke: bool) -> Path:
+    stamp = time.strftime("%Y%m%d-%H%M%S")
+    base = RESULTS / scene_path.stem / (stamp + ("-smoke" if smoke else ""))
+    d, k = base, 1
+    while d.exists():
+        k += 1
+        d = base.with_name(f"{base.name}-{k}")
+    return d
+
+
+def _save_checkpoint(files: RunFiles, scene: Scene, state: State, dimension: int) -> None:
+    data = {"scene": scene.model_dump(mode="json"), "dimension": dimension,
+            "accepted": state.accepted, "pending": state.pending, "cuts": state.cuts,
+            "launches": state.launches, "mesh_seconds": state.mesh_seconds, "post_seconds": state.post_seconds}
+    tmp = files.checkpoint.with_suffix(".tmp")
+    tmp.write_text(json.dumps(data, indent=1))
+    os.replace(tmp, files.checkpoint)
+
+
+def _resume(root: Path) -> tuple[RunFiles, Scene, State]:
+    files = RunFiles(root)
+    if not files.checkpoint.is_file():
+        raise FileNotFoundError(f"{root}: no checkpoint.json to resume from")
+    data = json.loads(files.checkpoint.read_text())
+    scene = Scene.model_validate(data["scene"])
+    state = State(accepted=[tuple(a) for a in data["accepted"]], pending=data["pending"], cuts=data["cuts"],
+                  launches=data["launches"], mesh_seconds=data["mesh_seconds"], post_seconds=data["post_seconds"])
+    # An increment committed after the last checkpoint is taken as it is; a partial one is dropped.
+    accept(scene, files, state, data["dimension"])
+    nxt = files.fem / f"inc-{state.last[0] + 1:04d}"
+    if nxt.is_dir():
+        shutil.rmtree(nxt)
+    return files, scene, state
+
+
+class _Progress:
+    """Prints a line per committed increment while FreeFEM runs (watches the `done` markers)."""
+
+    def __init__(self, fem: Path, inc0: int, count: int, loads: list[float], progress):
+        self.fem, self.inc0, self.count, self.loads, self.progress = fem, inc0, count, list(loads), progress
+        self.stop = threading.Event()
+        self.t0 = time.perf_counter()
+
+    def __enter__(self):
+        self.thread = threading.Thread(target=self._watch, daemon=True)
+        self.thread.start()
+        return self
+
+    def __exit__(self, *exc):
+        self.stop.set()
+        self.thread.join()
+        self._report()
+        return False
+
+    def _watch(self):
+        while not self.stop.wait(0.5):
+            self._report()
+
+    def _report(self):
+        while self.count > 0:
+            d = self.fem / f"inc-{self.inc0:04d}"
+            if not (d / "done").is_file():
+                return
+            try:
+                rec = json.loads((d / "record.json").read_text())
+            except (OSError, ValueError):
+                return
+            self.progress(f"  increment {rec['increment']}: load factor {rec['load_factor']:g}, "
+                          f"{rec['newton_iterations']} Newton iterations, "
+                          f"{time.perf_counter() - self.t0:.1f} s")
+            self.inc0 += 1
+            self.count -= 1

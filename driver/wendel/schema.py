@@ -1,0 +1,217 @@
+"""The scene schema: every key once, with type, default, unit, range and help.
+
+Validation, ``wendel check``, the CLI help and the README's key table all come from these models.
+Lengths in m, stresses and moduli in Pa, forces per volume in N/m^3, times in s.
+
+>>> Material(E=2.5, nu=0.25).nu
+0.25
+"""
+
+from __future__ import annotations
+
+import inspect
+from typing import Literal, Optional
+
+from pydantic import BaseModel, ConfigDict, Field, create_model, field_validator, model_validator
+
+from .blocks import BLOCKS, load_all
+from .meshes import BUILDERS
+
+# Names a scene may use, mapped to the integer ids of edp/lib/loads.idp (never code).
+BODY_FORCES = {"none": 0, "constant": 1, "step8-discs": 2, "manufactured": 3}
+ANALYTIC_REFERENCES = {"manufactured-sine": 1}
+SOLVERS = ("direct", "cg", "ffddm")
+
+
+class Strict(BaseModel):
+    """Base of every scene table: unknown keys are errors."""
+
+    model_config = ConfigDict(extra="forbid", validate_assignment=True)
+
+
+class Geometry(Strict):
+    """Where the mesh comes from: a builder of meshes/ with its parameters, or a mesh file."""
+
+    model_config = ConfigDict(extra="allow")
+    builder: Optional[str] = Field(None, description="gmsh builder of meshes/ (rectangle, box, ring, ...)")
+    mesh: Optional[str] = Field(None, description="MSH 2.2 file, relative to the scene file")
+    h: float = Field(0.1, gt=0, description="target element size [m]")
+    dimension: Optional[int] = Field(None, description="2 or 3; needed only with `mesh`")
+
+    @model_validator(mode="after")
+    def _source(self):
+        if (self.builder is None) == (self.mesh is None):
+            raise ValueError("give exactly one of `builder` or `mesh`")
+        if self.builder is not None:
+            if self.builder not in BUILDERS:
+                raise ValueError(f"unknown builder {self.builder!r}; valid: {', '.join(sorted(BUILDERS))}")
+            allowed = set(inspect.signature(BUILDERS[self.builder]).parameters) - {"path", "h"}
+            unknown = set(self.model_extra or {}) - allowed
+            if unknown:
+                raise ValueError(
+                    f"unknown key(s) {', '.join(sorted(unknown))} for builder {self.builder!r}; "
+                    f"valid: h, {', '.join(sorted(allowed))}")
+        elif self.model_extra:
+            raise ValueError(f"unknown key(s) {', '.join(sorted(self.model_extra))} next to `mesh`")
+        elif self.dimension not in (2, 3):
+            raise ValueError("a `mesh` file needs `dimension = 2` or `3`")
+        return self
+
+    @property
+    def params(self) -> dict:
+        """Builder parameters (everything but builder/mesh/dimension)."""
+        return {"h": self.h, **(self.model_extra or {})}
+
+
+class Material(Strict):
+    """Isotropic elastic constants."""
+
+    E: float = Field(..., gt=0, description="Young's modulus [Pa]")
+    nu: float = Field(..., gt=-1, lt=0.5, description="Poisson's ratio [1], in (-1, 0.5)")
+
+
+class Elasticity(Strict):
+    """Options of the elastic part (present in every mechanical scene)."""
+
+    plane: Literal["strain", "stress"] = Field("strain", description="2D hypothesis")
+
+
+class Boundary(Strict):
+    """Conditions on one named boundary; each displacement component is optional (free if absent)."""
+
+    ux: Optional[float] = Field(None, description="prescribed x displacement at load factor 1 [m]")
+    uy: Optional[float] = Field(None, description="prescribed y displacement at load factor 1 [m]")
+    uz: Optional[float] = Field(None, description="prescribed z displacement at load factor 1 [m]")
+    traction: Optional[list[float]] = Field(None, description="traction vector at load factor 1 [Pa]")
+    pressure: Optional[float] = Field(None, description="normal pressure at load factor 1 [Pa]")
+
+    @field_validator("traction")
+    @classmethod
+    def _traction(cls, v):
+        if v is not None and len(v) not in (2, 3):
+            raise ValueError("traction has 2 (2D) or 3 (3D) components")
+        return v
+
+
+class BodyForce(Strict):
+    """A named body force (edp/lib/loads.idp)."""
+
+    kind: str = Field("none", description=f"one of {', '.join(BODY_FORCES)}")
+    value: list[float] = Field([0.0, 0.0, 0.0], description="vector or magnitude(s) at load factor 1 [N/m^3]")
+
+    @field_validator("kind")
+    @classmethod
+    def _kind(cls, v):
+        if v not in BODY_FORCES:
+            raise ValueError(f"unknown body force {v!r}; valid: {', '.join(BODY_FORCES)}")
+        return v
+
+
+class Loading(Strict):
+    """The load path: increments of the load factor from 0 to `final`."""
+
+    steps: int = Field(1, ge=1, description="number of equal increments")
+    final: float = Field(1.0, description="final load factor [1]")
+    factors: Optional[list[float]] = Field(None, description="explicit load factors (replaces steps/final)")
+    max_cuts: int = Field(6, ge=0, le=30, description="step halvings allowed per increment")
+
+    def load_factors(self) -> list[float]:
+        """The target load factors in order."""
+        if self.factors:
+            return [float(f) for f in self.factors]
+        return [self.final * (i + 1) / self.steps for i in range(self.steps)]
+
+
+class Numerics(Strict):
+    """Solver settings."""
+
+    ranks: int = Field(1, ge=1, le=64, description="MPI ranks")
+    solver: str = Field("direct", description=f"linear solver: {', '.join(SOLVERS)}")
+    solver_tol: float = Field(1e-10, gt=0, lt=1, description="relative residual of iterative solvers [1]")
+    newton_tol: float = Field(1e-9, gt=0, lt=1, description="relative Newton residual [1]")
+    newton_maxit: int = Field(25, ge=1, le=500, description="Newton iterations per increment")
+    timeout: float = Field(3600.0, gt=0, description="wall-time limit of one FreeFEM launch [s]")
+
+    @field_validator("solver")
+    @classmethod
+    def _solver(cls, v):
+        if v not in SOLVERS:
+            raise ValueError(f"unknown solver {v!r}; valid: {', '.join(SOLVERS)}")
+        return v
+
+    @model_validator(mode="after")
+    def _ranks(self):
+        if self.ranks > 1 and self.solver != "ffddm":
+            raise ValueError(f"solver {self.solver!r} runs on one rank; use solver = \"ffddm\" with ranks = {self.ranks}")
+        return self
+
+
+class Output(Strict):
+    """What a run writes besides summary.json and the histories."""
+
+    vtu: bool = Field(True, description="one VTU per increment and a PVD index")
+    png: bool = Field(True, description="picture of the deformed body at the last increment")
+    warp: float = Field(0.0, ge=0, description="displacement scale of the picture; 0 = automatic")
+
+
+class Reference(Strict):
+    """What errors are measured against."""
+
+    analytic: Optional[str] = Field(None, description=f"analytic field: {', '.join(ANALYTIC_REFERENCES)}")
+    quantity: str = Field("strain_energy", description="record.json quantity compared with the finest run")
+
+    @field_validator("analytic")
+    @classmethod
+    def _analytic(cls, v):
+        if v is not None and v not in ANALYTIC_REFERENCES:
+            raise ValueError(f"unknown analytic reference {v!r}; valid: {', '.join(ANALYTIC_REFERENCES)}")
+        return v
+
+
+class Smoke(Strict):
+    """The tiny size every scene declares (`wendel run --smoke`, CI): overrides of geometry and loading."""
+
+    model_config = ConfigDict(extra="forbid")
+    h: Optional[float] = Field(None, gt=0, description="element size of the smoke run [m]")
+    steps: Optional[int] = Field(None, ge=1, description="increments of the smoke run")
+    ranks: Optional[int] = Field(None, ge=1, description="MPI ranks of the smoke run")
+
+
+def _scene_model():
+    load_all()
+    extra = {name: (Optional[block.model], None) for name, block in BLOCKS.items()}
+    return create_model(
+        "Scene",
+        __base__=SceneBase,
+        **extra,
+    )
+
+
+class SceneBase(Strict):
+    """A scene: a one-line description, then geometry, material, physics, loading, numerics, output."""
+
+    description: str = Field(..., min_length=1, description="one line saying what is simulated")
+    geometry: Geometry
+    material: Material
+    elasticity: Elasticity = Elasticity()
+    boundary: dict[str, Boundary] = Field(default_factory=dict, description="conditions by boundary name")
+    body_force: BodyForce = BodyForce()
+    loading: Loading = Loading()
+    numerics: Numerics = Numerics()
+    output: Output = Output()
+    reference: Reference = Reference()
+    smoke: Smoke = Smoke()
+
+    @model_validator(mode="after")
+    def _consistency(self):
+        if self.body_force.kind == "manufactured" and self.reference.analytic is None:
+            raise ValueError("body_force.kind = \"manufactured\" needs reference.analytic")
+        return self
+
+    @property
+    def blocks(self) -> list[str]:
+        """Names of the optional physics blocks present, in entry-script order."""
+        return sorted(name for name in BLOCKS if getattr(self, name, None) is not None)
+
+
+Scene = _scene_model()
