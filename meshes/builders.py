@@ -104,7 +104,7 @@ def _write(gmsh, path: Path, dimension: int, boundaries: list[str]) -> Built:
 
 def _tag_boxes(gmsh, dim: int, lo, hi, names: list[str]):
     """Put the boundary entities of a box/rectangle into named physical groups by their position."""
-    tol = 1e-9 * max(h - l for l, h in zip(lo, hi))
+    tol = 1e-6 * max(h - l for l, h in zip(lo, hi)) + 1e-6  # OCC pads bounding boxes by 1e-7
     groups: dict[str, list[int]] = {n: [] for n in names}
     axes = [("left", "right"), ("bottom", "top")] if dim == 2 else [("left", "right"), ("front", "back"), ("bottom", "top")]
     for _, tag in gmsh.model.getEntities(dim - 1):
