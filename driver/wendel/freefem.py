@@ -106,7 +106,7 @@ def run(entry: str, options: list[str], out_dir: Path, ranks: int = 1, timeout: 
     Raises :class:`FreeFemError` (with .file and .line), :class:`FreeFemTimeout` or
     :class:`NewtonFailure`.
     """
-    script = EDP / entry
+    script = Path(entry) if Path(entry).is_absolute() else EDP / entry
     if not script.is_file():
         raise FreeFemError(f"no entry script {script}")
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -119,7 +119,7 @@ def run(entry: str, options: list[str], out_dir: Path, ranks: int = 1, timeout: 
     with open(log, "a") as flog:
         flog.write("$ " + " ".join(cmd) + "\n")
         flog.flush()
-        proc = subprocess.Popen(cmd, stdout=flog, stderr=subprocess.STDOUT, env=environment(),
+        proc = subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=flog, stderr=subprocess.STDOUT, env=environment(),
                                 start_new_session=True, cwd=out_dir)
         try:
             rc = proc.wait(timeout=timeout)

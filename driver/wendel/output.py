@@ -28,7 +28,7 @@ def read_array(path: Path) -> np.ndarray:
 
 def read_mesh(path: Path, dimension: int) -> tuple[np.ndarray, np.ndarray]:
     """Points (n, 3) and the cells of the given dimension of a gmsh file."""
-    m = meshio.read(path)
+    m = meshio.read(path, file_format="gmsh")
     cells = np.concatenate([b.data for b in m.cells if b.type == CELL_TYPES[dimension]])
     return m.points, cells
 

@@ -71,14 +71,21 @@ class State:
 
 
 def run(scene_path: str | Path, smoke: bool = False, ranks: int | None = None, out: Path | None = None,
-        resume: Path | None = None, progress=print) -> Path:
-    """Run the scene file ``scene_path``; return the run folder (results/<scene>/<run-id>/)."""
+        resume: Path | None = None, progress=print, h: float | None = None, png: bool | None = None) -> Path:
+    """Run the scene file ``scene_path``; return the run folder (results/<scene>/<run-id>/).
+
+    ``ranks``, ``h`` and ``png`` override numerics.ranks, geometry.h and output.png.
+    """
     scene_path = Path(scene_path)
     if resume is not None:
         files, scene, state = _resume(Path(resume))
         progress(f"resuming {files.root} after increment {state.last[0]} (load factor {state.last[1]:g})")
     else:
         scene = load(scene_path, smoke=smoke)
+        if h is not None:
+            scene.geometry.h = h
+        if png is not None:
+            scene.output.png = png
         if ranks is not None:
             scene.numerics.ranks = ranks
             if ranks > 1:

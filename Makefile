@@ -1,0 +1,49 @@
+# wendel: `make run` installs what is missing and runs the default scene; `make test` runs the tests.
+# A second call with everything in place installs nothing.
+
+SHELL := /bin/bash
+PYTHON ?= python3
+VENV := .venv
+APT_PACKAGES := freefem++ libfreefem++-dev openmpi-bin libopenblas0-pthread g++ \
+                libegl1 libegl-mesa0 libgl1 libgl1-mesa-dri libglu1-mesa
+SCENE ?= workflows/smoke.toml
+
+.PHONY: setup run test bench clean
+setup: build/.apt-ok $(VENV)/.ok build/plugins/MUMPS_mpi.so
+
+# Debian packages: FreeFEM, Open MPI, OpenBLAS under FreeFEM's direct solvers, Mesa for off-screen pictures.
+build/.apt-ok: Makefile
+	@mkdir -p build
+	@n_ok=$$(dpkg-query -W -f='$${Status}\n' $(APT_PACKAGES) 2>/dev/null | grep -c '^install ok installed$$'); \
+	if [ "$$n_ok" -eq "$(words $(APT_PACKAGES))" ]; then \
+	  echo "apt: all packages present"; \
+	else \
+	  echo "apt: installing $(APT_PACKAGES)"; \
+	  SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
+	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq --no-install-recommends $(APT_PACKAGES); \
+	fi
+	@touch $@
+
+# Python: a venv with the package in editable mode, versions pinned by constraints.txt.
+$(VENV)/.ok: pyproject.toml constraints.txt
+	$(PYTHON) -m venv $(VENV)
+	$(VENV)/bin/pip install -q --upgrade pip
+	$(VENV)/bin/pip install -q -c constraints.txt -e '.[test]'
+	@touch $@
+
+# The do-nothing MUMPS_mpi plugin that lets Debian's ffddm load (no PETSc/HPDDM here).
+build/plugins/MUMPS_mpi.so: edp/MUMPS_mpi_placeholder.cpp build/.apt-ok
+	@mkdir -p build/plugins
+	g++ -shared -fPIC -O1 -w -I/usr/include/freefem++ $< -o $@
+
+run: setup
+	$(VENV)/bin/wendel run $(SCENE)
+
+test: setup
+	$(VENV)/bin/python -m pytest -q
+
+bench: setup
+	$(VENV)/bin/wendel bench
+
+clean:
+	rm -rf build results
