@@ -62,7 +62,7 @@ def boundary_facets(cells):
     """Facets (edges of triangles, faces of tetrahedra) that belong to one cell only, oriented outward.
 
     >>> boundary_facets(np.array([[0, 1, 2], [0, 2, 3]])).tolist()
-    [[0, 1], [1, 2], [2, 3], [3, 0]]
+    [[0, 1], [3, 0], [1, 2], [2, 3]]
     """
     cells = np.asarray(cells)
     if cells.shape[1] == 3:
