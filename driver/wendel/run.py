@@ -74,28 +74,39 @@ def run(scene_path: str | Path, smoke: bool = False, ranks: int | None = None, o
         resume: Path | None = None, progress=print, h: float | None = None, png: bool | None = None) -> Path:
     """Run the scene file ``scene_path``; return the run folder (results/<scene>/<run-id>/).
 
-    ``ranks``, ``h`` and ``png`` override numerics.ranks, geometry.h and output.png.
+    ``ranks``, ``h`` and ``png`` override numerics.ranks, geometry.h and output.png; ``resume`` continues
+    the run folder given from its last checkpoint.
     """
-    scene_path = Path(scene_path)
     if resume is not None:
         files, scene, state = _resume(Path(resume))
         progress(f"resuming {files.root} after increment {state.last[0]} (load factor {state.last[1]:g})")
-    else:
-        scene = load(scene_path, smoke=smoke)
-        if h is not None:
-            scene.geometry.h = h
-        if png is not None:
-            scene.output.png = png
-        if ranks is not None:
-            scene.numerics.ranks = ranks
-            if ranks > 1:
-                scene.numerics.solver = "ffddm"
-        files = RunFiles(Path(out) if out else _new_run_dir(scene_path, smoke))
-        files.root.mkdir(parents=True, exist_ok=True)
-        report.write_provenance(files.root, scene_path, scene, smoke)
-        state = State(pending=scene.loading.load_factors())
-        state.mesh_seconds, dimension = build(scene, files)
-        _save_checkpoint(files, scene, state, dimension)
+        return _execute(scene, files, state, progress)
+    scene_path = Path(scene_path)
+    scene = load(scene_path, smoke=smoke)
+    if h is not None:
+        scene.geometry.h = h
+    if png is not None:
+        scene.output.png = png
+    if ranks is not None:
+        scene.numerics.ranks = ranks
+        if ranks > 1:
+            scene.numerics.solver = "ffddm"
+    return run_scene(scene, scene_path, Path(out) if out else _new_run_dir(scene_path, smoke), smoke, progress)
+
+
+def run_scene(scene: Scene, scene_path: Path, out: Path, smoke: bool = False, progress=print) -> Path:
+    """Run an already validated scene (read from ``scene_path``) into the folder ``out``."""
+    files = RunFiles(Path(out))
+    files.root.mkdir(parents=True, exist_ok=True)
+    report.write_provenance(files.root, Path(scene_path), scene, smoke)
+    state = State(pending=scene.loading.load_factors())
+    state.mesh_seconds, dimension = build(scene, files)
+    _save_checkpoint(files, scene, state, dimension)
+    return _execute(scene, files, state, progress)
+
+
+def _execute(scene: Scene, files: RunFiles, state: State, progress) -> Path:
+    """Solve the pending increments, then summary and picture."""
     dimension = json.loads(files.checkpoint.read_text())["dimension"]
     progress(f"wendel: {scene.description}")
     progress(f"  run folder {files.root}")
@@ -106,8 +117,7 @@ def run(scene_path: str | Path, smoke: bool = False, ranks: int | None = None, o
     if scene.output.png and state.accepted:
         t0 = time.perf_counter()
         last = files.vtu / f"inc-{state.last[0]:04d}.vtu"
-        output.picture(last, files.root / "deformed.png", f"{scene_path.stem}: load factor {state.last[1]:g}",
-                       scene.output.warp)
+        output.picture(last, files.root / "deformed.png", f"load factor {state.last[1]:g}", scene.output.warp)
         state.post_seconds += time.perf_counter() - t0
         report.write_summary(files.root, scene, state, dimension)
     return files.root

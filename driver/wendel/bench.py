@@ -1,0 +1,119 @@
+"""Benchmarks (``wendel bench [NAME ...] [--quick]``): speed and cost figures written to results/bench/.
+
+A benchmark is a function registered with :func:`register`; it returns a list of rows (dicts) that
+are written as ``results/bench/<name>.csv`` and ``.json`` together with the machine it ran on.
+Ratios are always taken within one benchmark run.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import os
+import platform
+import shutil
+import time
+from pathlib import Path
+from typing import Callable
+
+from .run import RESULTS, run
+
+BENCHES: dict[str, Callable[[bool, Path], list[dict]]] = {}
+
+
+def register(name: str):
+    """Register a benchmark ``func(quick, workdir) -> rows`` under ``name``."""
+
+    def wrap(func):
+        BENCHES[name] = func
+        return func
+
+    return wrap
+
+
+def bench(names: list[str] | None = None, quick: bool = False, out: Path | None = None, progress=print) -> Path:
+    """Run the named benchmarks (all by default); return the folder with their results."""
+    _load_plugins()
+    names = names or sorted(BENCHES)
+    unknown = [n for n in names if n not in BENCHES]
+    if unknown:
+        raise KeyError(f"unknown benchmark(s) {', '.join(unknown)}; valid: {', '.join(sorted(BENCHES))}")
+    root = Path(out) if out else RESULTS / "bench"
+    root.mkdir(parents=True, exist_ok=True)
+    for name in names:
+        progress(f"bench {name} ...")
+        t0 = time.perf_counter()
+        rows = BENCHES[name](quick, root / "work" / name)
+        meta = {"name": name, "quick": quick, "seconds": time.perf_counter() - t0, "cpus": os.cpu_count(),
+                "platform": platform.platform(), "date": time.strftime("%Y-%m-%dT%H:%M:%S%z")}
+        (root / f"{name}.json").write_text(json.dumps({"meta": meta, "rows": rows}, indent=1))
+        if rows:
+            keys = list(dict.fromkeys(k for r in rows for k in r))
+            with open(root / f"{name}.csv", "w", newline="") as f:
+                w = csv.DictWriter(f, fieldnames=keys)
+                w.writeheader()
+                w.writerows(rows)
+            progress(_table(rows))
+    return root
+
+
+def _table(rows: list[dict]) -> str:
+    keys = list(dict.fromkeys(k for r in rows for k in r))
+    fmt = lambda v: f"{v:.4g}" if isinstance(v, float) else str(v)
+    lines = ["| " + " | ".join(keys) + " |", "|" + "---|" * len(keys)]
+    lines += ["| " + " | ".join(fmt(r.get(k, "")) for k in keys) + " |" for r in rows]
+    return "\n".join(lines)
+
+
+def _load_plugins() -> None:
+    """Benchmarks of the physics modules live beside them (``wendel.benches_*`` modules)."""
+    import importlib
+    import pkgutil
+
+    import wendel
+
+    for info in pkgutil.iter_modules(wendel.__path__):
+        if info.name.startswith("benches_"):
+            importlib.import_module(f"wendel.{info.name}")
+
+
+def run_summary(scene: Path, workdir: Path, **kw) -> dict:
+    """Run a scene quietly without a picture and return its summary.json."""
+    root = run(scene, out=workdir, png=False, progress=lambda *_: None, **kw)
+    return json.loads((root / "summary.json").read_text())
+
+
+WORKFLOWS = Path(__file__).resolve().parents[2] / "workflows"
+
+
+@register("elasticity")
+def elasticity(quick: bool, workdir: Path) -> list[dict]:
+    """The smoke problem at growing sizes: direct solver vs ffddm on 1 and 2 ranks; start-up share."""
+    sizes = [0.05, 0.025] if quick else [0.05, 0.025, 0.0125, 0.00625]
+    rows = []
+    for h in sizes:
+        for solver, ranks in (("direct", 1), ("ffddm", 1), ("ffddm", 2)):
+            tag = f"h{h:g}-{solver}-np{ranks}"
+            shutil.rmtree(workdir / tag, ignore_errors=True)
+            s = _run_with(WORKFLOWS / "smoke.toml", workdir / tag, h=h, solver=solver, ranks=ranks)
+            ph = s["wall_time_by_phase"]
+            rows.append({"h": h, "dofs": s["dofs"], "solver": solver, "ranks": ranks,
+                         "wall_time": s["wall_time"], "assembly": ph["assembly"], "linear_solve": ph["linear_solve"],
+                         "startup": ph["freefem_startup"], "io": ph["freefem_output"] + ph["driver_output"],
+                         "share_startup_io": s["share_startup_and_io"],
+                         "linear_iterations": s["last_increment"]["linear_iterations"]})
+    return rows
+
+
+def _run_with(scene_path: Path, workdir: Path, h: float, solver: str, ranks: int) -> dict:
+    """Run a scene with a given size, solver and rank count (no picture)."""
+    from . import run as runmod
+    from .scene import load
+
+    scene = load(scene_path)
+    scene.geometry.h = h
+    scene.numerics.solver = solver
+    scene.numerics.ranks = ranks
+    scene.output.png = False
+    root = runmod.run_scene(scene, scene_path, workdir, progress=lambda *_: None)
+    return json.loads((root / "summary.json").read_text())
