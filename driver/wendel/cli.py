@@ -35,6 +35,9 @@ def main(argv: list[str] | None = None) -> int:
     p = sub.add_parser("check", help="validate a scene file without running it")
     p.add_argument("scene", nargs="+")
 
+    p = sub.add_parser("keys", help="print the scene keys (type, default, unit, range) as a Markdown table")
+    p.add_argument("--update", type=Path, metavar="README", help="rewrite the table in this file instead")
+
     p = sub.add_parser("bench", help="benchmarks; results into results/bench/")
     p.add_argument("names", nargs="*", help="benchmarks to run (default all)")
     p.add_argument("--quick", action="store_true", help="small sizes only")
@@ -61,6 +64,13 @@ def main(argv: list[str] | None = None) -> int:
             from .study import study
             root = study(args.scene, levels=args.levels, smoke=args.smoke, ranks=args.np, out=args.out)
             print(f"study written to {root}")
+            return 0
+        if args.command == "keys":
+            from .schema import keys_table, update_readme
+            if args.update:
+                print(f"{args.update}: {'updated' if update_readme(args.update) else 'up to date'}")
+            else:
+                print(keys_table())
             return 0
         if args.command == "bench":
             from .bench import bench

@@ -215,3 +215,56 @@ class SceneBase(Strict):
 
 
 Scene = _scene_model()
+
+
+def _describe(model: type[BaseModel], prefix: str) -> list[tuple[str, str, str, str]]:
+    rows = []
+    for name, f in model.model_fields.items():
+        ann = f.annotation
+        if isinstance(ann, type) and issubclass(ann, BaseModel):
+            rows += _describe(ann, f"{prefix}{name}.")
+            continue
+        args = getattr(ann, "__args__", ())
+        sub = [a for a in args if isinstance(a, type) and issubclass(a, BaseModel)]
+        if sub and name in BLOCKS:
+            rows += _describe(sub[0], f"{prefix}{name}.")
+            continue
+        if sub:   # dict of tables, e.g. boundary.<name>
+            rows += _describe(sub[0], f"{prefix}{name}.<name>.")
+            continue
+        rng = ", ".join(f"{type(m).__name__.lower()} {getattr(m, type(m).__name__.lower(), '')}"
+                        for m in f.metadata if type(m).__name__ in ("Gt", "Ge", "Lt", "Le"))
+        inner = [a for a in args if a is not type(None)]
+        if getattr(ann, "__name__", "") == "Literal" or str(ann).startswith("typing.Literal"):
+            typ = " \\| ".join(repr(a) for a in args)
+        elif type(None) in args and inner:
+            typ = getattr(inner[0], "__name__", str(inner[0])) + ", optional"
+        else:
+            typ = getattr(ann, "__name__", str(ann))
+        default = "required" if f.is_required() else repr(f.default) if f.default_factory is None else "{}"
+        rows.append((prefix + name, typ, default, (f.description or "") + (f" ({rng})" if rng else "")))
+    return rows
+
+
+KEYS_BEGIN, KEYS_END = "<!-- scene keys: begin (wendel keys --update README.md) -->", "<!-- scene keys: end -->"
+
+
+def update_readme(path) -> bool:
+    """Replace the key table between the markers of ``path``; return whether it changed."""
+    from pathlib import Path
+
+    text = Path(path).read_text()
+    head, rest = text.split(KEYS_BEGIN, 1)
+    _, tail = rest.split(KEYS_END, 1)
+    new = f"{head}{KEYS_BEGIN}\n{keys_table()}\n{KEYS_END}{tail}"
+    if new != text:
+        Path(path).write_text(new)
+    return new != text
+
+
+def keys_table() -> str:
+    """The scene keys as a Markdown table (the README's table is this text; a test keeps them equal)."""
+    rows = _describe(Scene, "")
+    lines = ["| key | type | default | meaning |", "|---|---|---|---|"]
+    lines += [f"| `{k}` | {t} | {d} | {m} |" for k, t, d, m in rows]
+    return "\n".join(lines)

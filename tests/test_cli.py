@@ -1,0 +1,41 @@
+"""The command line and the README contract."""
+
+import subprocess
+import sys
+from pathlib import Path
+
+from wendel.cli import main
+from wendel.schema import KEYS_BEGIN, KEYS_END, keys_table
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_readme_key_table_is_the_schema():
+    text = (ROOT / "README.md").read_text()
+    table = text.split(KEYS_BEGIN, 1)[1].split(KEYS_END, 1)[0].strip()
+    assert table == keys_table(), "run: .venv/bin/wendel keys --update README.md"
+
+
+def test_readme_lists_every_scene():
+    text = (ROOT / "README.md").read_text()
+    for scene in sorted((ROOT / "workflows").glob("*.toml")):
+        assert f"`{scene.name}`" in text, f"README does not list {scene.name}"
+
+
+def test_version_and_usage_errors(capsys):
+    out = subprocess.run([sys.executable, "-m", "wendel.cli", "--version"], capture_output=True, text=True)
+    assert out.returncode == 0 and out.stdout.startswith("wendel ")
+    assert main(["run", str(ROOT / "workflows" / "nope.toml")]) == 2
+    assert "no such scene file" in capsys.readouterr().err
+
+
+def test_run_failure_exit_code(tmp_path, scene_file, capsys):
+    from conftest import SMOKE_SCENE
+
+    # a tolerance below round-off cannot be met: every increment and every cut fails
+    text = SMOKE_SCENE.replace("[numerics]", "[numerics]\nnewton_maxit = 3\nnewton_tol = 1e-300")
+    text = text.replace("[loading]\nsteps = 1", "[loading]\nsteps = 1\nmax_cuts = 1")
+    path = scene_file(text)
+    assert main(["run", str(path), "--smoke", "--out", str(tmp_path / "r")]) == 1
+    err = capsys.readouterr().err
+    assert "even after 1 step halvings" in err and "0 accepted increments are kept" in err
