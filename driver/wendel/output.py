@@ -26,6 +26,14 @@ def read_array(path: Path) -> np.ndarray:
     return data[1:]
 
 
+def write_array(path: Path, values) -> None:
+    """Write edp's plain array format (count, then one value per line, full precision)."""
+    v = np.asarray(values, dtype=float).ravel()
+    with open(path, "w") as f:
+        f.write(f"{v.size}\n")
+        np.savetxt(f, v, fmt="%.17g")
+
+
 def read_mesh(path: Path, dimension: int) -> tuple[np.ndarray, np.ndarray]:
     """Points (n, 3) and the cells of the given dimension of a gmsh file."""
     m = meshio.read(path, file_format="gmsh")
