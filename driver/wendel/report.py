@@ -129,6 +129,7 @@ def write_summary(root: Path, scene, state, dimension: int) -> dict:
         "wall_time_by_phase": phases,
         "share_startup_and_io": (phases["freefem_startup"] + phases["freefem_output"] + phases["driver_output"]) / total
         if total else None,
+        "errors": {k: v for k, v in last.items() if k.startswith("error_") and isinstance(v, (int, float)) and v >= 0},
         "last_increment": last,
     }
     tmp = root / "summary.json.tmp"

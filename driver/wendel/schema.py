@@ -155,9 +155,12 @@ class Output(Strict):
 
 
 class Reference(Strict):
-    """What errors are measured against."""
+    """What errors are measured against: an analytic field, errors a module computes against a closed
+    form (record.json keys ``error_*``), or else the finest run of a study."""
 
     analytic: Optional[str] = Field(None, description=f"analytic field: {', '.join(ANALYTIC_REFERENCES)}")
+    errors: list[str] = Field(default_factory=list,
+                              description="record.json keys of errors against closed forms, e.g. error_hertz_p0")
     quantity: str = Field("strain_energy", description="record.json quantity compared with the finest run")
 
     @field_validator("analytic")
@@ -165,6 +168,14 @@ class Reference(Strict):
     def _analytic(cls, v):
         if v is not None and v not in ANALYTIC_REFERENCES:
             raise ValueError(f"unknown analytic reference {v!r}; valid: {', '.join(ANALYTIC_REFERENCES)}")
+        return v
+
+    @field_validator("errors")
+    @classmethod
+    def _errors(cls, v):
+        bad = [k for k in v if not k.startswith("error_")]
+        if bad:
+            raise ValueError(f"error keys start with error_: {', '.join(bad)}")
         return v
 
 
