@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from . import freefem, output, report
-from .blocks import BLOCKS
+from .blocks import BLOCKS, PROBLEMS
 from .meshes import LABELS, build as build_mesh
 from .schema import ANALYTIC_REFERENCES, BODY_FORCES, Scene
 from .scene import load
@@ -222,18 +222,23 @@ def cut_step(scene: Scene, files: RunFiles, state: State, failure: freefem.Newto
 
 def entry_script(scene: Scene, dimension: int) -> str:
     """The entry script that includes exactly the scene's physics modules."""
+    if scene.problem != "mechanics":
+        return PROBLEMS[scene.problem].entry(scene, dimension)
     tags = "".join(f"-{b}" for b in scene.blocks)
     return f"solve-{dimension}d{tags}.edp"
 
 
 def options(scene: Scene, files: RunFiles, dimension: int) -> list[str]:
     """FreeFEM options of the scene: numbers and integer ids only."""
-    m, n = scene.material, scene.numerics
-    opts = ["-mesh", str(files.mesh), "-mat_E", repr(m.E), "-mat_nu", repr(m.nu),
-            "-el_plane_stress", "1" if scene.elasticity.plane == "stress" else "0",
-            "-solver", n.solver, "-solver_tol", repr(n.solver_tol),
-            "-newton_tol", repr(n.newton_tol), "-newton_maxit", str(n.newton_maxit),
-            "-bc", str(files.tables / "bc.txt"), "-trac", str(files.tables / "trac.txt")]
+    n = scene.numerics
+    opts = ["-mesh", str(files.mesh), "-solver", n.solver, "-solver_tol", repr(n.solver_tol),
+            "-newton_tol", repr(n.newton_tol), "-newton_maxit", str(n.newton_maxit)]
+    if scene.problem != "mechanics":
+        return opts + PROBLEMS[scene.problem].options(scene, files, dimension)
+    m = scene.material
+    opts += ["-mat_E", repr(m.E), "-mat_nu", repr(m.nu),
+             "-el_plane_stress", "1" if scene.elasticity.plane == "stress" else "0",
+             "-bc", str(files.tables / "bc.txt"), "-trac", str(files.tables / "trac.txt")]
     bf = scene.body_force
     v = list(bf.value) + [0.0] * (3 - len(bf.value))
     opts += ["-body_id", str(BODY_FORCES[bf.kind]), "-body_fx", repr(v[0]), "-body_fy", repr(v[1]),

@@ -14,7 +14,7 @@ from typing import Literal, Optional
 
 from pydantic import BaseModel, ConfigDict, Field, create_model, field_validator, model_validator
 
-from .blocks import BLOCKS, load_all
+from .blocks import BLOCKS, PROBLEMS, load_all
 from .meshes import BUILDERS
 
 # Names a scene may use, mapped to the integer ids of edp/lib/loads.idp (never code).
@@ -202,8 +202,9 @@ class SceneBase(Strict):
     """A scene: a one-line description, then geometry, material, physics, loading, numerics, output."""
 
     description: str = Field(..., min_length=1, description="one line saying what is simulated")
+    problem: str = Field("mechanics", description="mechanics (default) or a registered scalar problem")
     geometry: Geometry
-    material: Material
+    material: Optional[Material] = Field(None, description="required by mechanics")
     elasticity: Elasticity = Elasticity()
     boundary: dict[str, Boundary] = Field(default_factory=dict, description="conditions by boundary name")
     body_force: BodyForce = BodyForce()
@@ -215,14 +216,32 @@ class SceneBase(Strict):
 
     @model_validator(mode="after")
     def _consistency(self):
+        if self.problem == "mechanics":
+            if self.material is None:
+                raise ValueError("material: Field required")
+            foreign = [n for n, b in BLOCKS.items() if not b.mechanics and getattr(self, n, None) is not None]
+            if foreign:
+                raise ValueError(f"table(s) {', '.join(foreign)} belong to another problem; set `problem`")
+        elif self.problem not in PROBLEMS:
+            raise ValueError(f"unknown problem {self.problem!r}; valid: mechanics, {', '.join(sorted(PROBLEMS))}")
+        else:
+            allowed = set(PROBLEMS[self.problem].tables)
+            present = {name for name in BLOCKS if getattr(self, name, None) is not None}
+            present |= {t for t in ("material",) if getattr(self, t) is not None}
+            present |= {t for t in ("boundary",) if getattr(self, t)}
+            extra = sorted(present - allowed)
+            if extra:
+                raise ValueError(f"problem {self.problem!r} does not use the table(s) {', '.join(extra)}")
         if self.body_force.kind == "manufactured" and self.reference.analytic is None:
             raise ValueError("body_force.kind = \"manufactured\" needs reference.analytic")
         return self
 
     @property
     def blocks(self) -> list[str]:
-        """Names of the optional physics blocks present, in entry-script order."""
-        return sorted(name for name in BLOCKS if getattr(self, name, None) is not None)
+        """Names of the optional physics blocks present, in entry-script order (mechanics only)."""
+        if self.problem != "mechanics":
+            return []
+        return sorted(n for n, b in BLOCKS.items() if b.mechanics and getattr(self, n, None) is not None)
 
 
 Scene = _scene_model()

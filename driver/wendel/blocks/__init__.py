@@ -34,12 +34,16 @@ class Block:
         ``files`` is a :class:`wendel.run.RunFiles` where a block may write tables it needs.
     fields : tuple of str
         Names of the VTU fields the module writes (documentation and tests).
+    mechanics : bool
+        True for a module of the mechanics entry scripts; False for the table of a scalar problem
+        (see :class:`Problem`), which mechanics scenes refuse.
     """
 
     name: str
     model: type[BaseModel]
     options: Callable[[Any, Any, Any], list[str]]
     fields: tuple[str, ...] = ()
+    mechanics: bool = True
 
 
 BLOCKS: dict[str, Block] = {}
@@ -49,6 +53,39 @@ def register(block: Block) -> Block:
     """Add ``block`` to the registry (called at import time by each block module)."""
     BLOCKS[block.name] = block
     return block
+
+
+@dataclasses.dataclass(frozen=True)
+class Problem:
+    """A problem other than the default quasi-static mechanics (a scene's top-level ``problem`` key).
+
+    Attributes
+    ----------
+    name : str
+        Value of ``problem`` in the scene.
+    entry : callable
+        ``entry(scene, dimension) -> str``: the entry script in edp/.
+    options : callable
+        ``options(scene, files, dimension) -> list[str]``: its FreeFEM options besides the common ones
+        (-mesh, -loads, -inc0, -restart, -solver*, -newton_*).
+    tables : tuple of str
+        The top-level tables (blocks) the problem reads, e.g. ``("obstacle",)``; the mechanics tables
+        (material, elasticity, boundary, body_force) are refused for it unless listed.
+    """
+
+    name: str
+    entry: Callable[[Any, int], str]
+    options: Callable[[Any, Any, int], list[str]]
+    tables: tuple[str, ...] = ()
+
+
+PROBLEMS: dict[str, Problem] = {}
+
+
+def register_problem(problem: Problem) -> Problem:
+    """Add ``problem`` to the registry."""
+    PROBLEMS[problem.name] = problem
+    return problem
 
 
 def load_all() -> dict[str, Block]:
