@@ -10,6 +10,12 @@ through a registry of names to the integer ids of ``-contact_obstacle``:
 '+y'
 >>> options(Contact(boundary="top", normal="+z", displacement=-1e-3), None, None)[:6]
 ['-contact_label', '4', '-contact_axis', '2', '-contact_dir', '1']
+
+The scalar membrane obstacle problem (deal.II step-41, ``edp/obstacle.edp``) is the problem
+``membrane-obstacle`` with its table ``[obstacle]``:
+
+>>> MembraneObstacle(shape="radial").c
+100.0
 """
 
 from __future__ import annotations
@@ -19,7 +25,10 @@ from typing import Optional
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
-from . import Block, register
+import json
+import shutil
+
+from . import Block, Problem, register, register_problem
 from ..meshes import LABELS
 
 OBSTACLES = {"plane": 1, "ball": 2, "cylinder": 3, "heightmap": 4}
@@ -115,3 +124,63 @@ def options(block: Contact, scene, files) -> list[str]:
 
 register(Block(name="contact", model=Contact, options=options,
                fields=("contact_pressure", "contact_active", "contact_gap")))
+
+
+MEMBRANE_SHAPES = {"staircase": 1, "radial": 2}
+"""Membrane obstacle name -> ``-obst_id`` of obstacle.edp."""
+
+
+class MembraneObstacle(BaseModel):
+    """The membrane obstacle problem -Laplace(u) = f, u >= g, by PDAS (edp/obstacle.edp)."""
+
+    model_config = ConfigDict(extra="forbid", validate_assignment=True)
+
+    shape: str = Field("staircase", description="obstacle and data: staircase (step-41, u = 0 on the boundary), "
+                       "radial (g = sqrt(1 - r^2), exact solution as boundary data and reference)")
+    f: Optional[float] = Field(None, description="load density [1/m]; default -10 (staircase), 0 (radial)")
+    c: float = Field(100.0, gt=0, description="active-set constant [1/m^2]; the solution does not depend on it")
+
+    @field_validator("shape")
+    @classmethod
+    def _shape(cls, v):
+        if v not in MEMBRANE_SHAPES:
+            raise ValueError(f"unknown membrane obstacle {v!r}; valid: {', '.join(MEMBRANE_SHAPES)}")
+        return v
+
+
+def _membrane_entry(scene, dimension: int) -> str:
+    if dimension != 2:
+        raise ValueError("problem 'membrane-obstacle' is 2D")
+    return "obstacle.edp"
+
+
+def _membrane_options(scene, files, dimension: int) -> list[str]:
+    o = scene.obstacle or MembraneObstacle()
+    opts = ["-obst_id", str(MEMBRANE_SHAPES[o.shape]), "-obst_c", repr(o.c)]
+    if o.f is not None:
+        opts += ["-obst_f", repr(o.f)]
+    return opts
+
+
+register(Block(name="obstacle", model=MembraneObstacle, options=lambda *_: [], fields=("u", "lambda", "active", "gap"),
+               mechanics=False))
+register_problem(Problem(name="membrane-obstacle", entry=_membrane_entry, options=_membrane_options,
+                         tables=("obstacle",)))
+
+
+def bench_obstacle(quick: bool, workdir) -> list[dict]:
+    """step-41 at 3 mesh sizes: active-set iterations, DoFs, wall time (register as ``wendel bench obstacle``)."""
+    from ..run import run
+
+    scene = ROOT / "workflows" / "obstacle.toml"
+    rows = []
+    for n in ((16, 32, 64) if quick else (32, 64, 128)):
+        out = workdir / f"n{n}"
+        shutil.rmtree(out, ignore_errors=True)
+        root = run(scene, out=out, h=2.0 / n, png=False, progress=lambda *_: None)
+        s = json.loads((root / "summary.json").read_text())
+        last = s["last_increment"]
+        rows.append({"cells_per_side": n, "dofs": s["dofs"], "active_set_iterations": last["active_set_iterations"],
+                     "step41_iterations": 18 if n == 128 else None, "active_nodes": last["active_nodes"],
+                     "wall_time": s["wall_time"], "solve_time": last["time_solve"]})
+    return rows
