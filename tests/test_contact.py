@@ -184,3 +184,30 @@ def test_3d_obstacles(meshes, tmp_path, shape):
         assert np.ptp(act[:, 1]) > 3 * np.ptp(act[:, 0])
     if shape == "stamp":        # only the raised ring and bar touch: nothing at the centre's corners
         assert np.all(np.abs(act[:, :2]).max(axis=1) < 0.6 + 0.2)
+
+
+# ---------------------------------------------------------------- scenes through the driver
+
+@pytest.mark.parametrize("name", ["obstacle", "obstacle-radial"])
+def test_membrane_obstacle_scenes_run(tmp_path, name):
+    root = run(WORKFLOWS / f"{name}.toml", smoke=True, out=tmp_path / name, progress=lambda *_: None)
+    s = json.loads((root / "summary.json").read_text())
+    last = s["last_increment"]
+    assert s["completed"] and last["active_nodes"] > 0
+    assert all(last[k] < 1e-8 for k in KKT)
+    import meshio
+
+    mesh = meshio.read(root / "vtu" / "inc-0001.vtu")
+    assert {"u", "lambda", "active", "gap"} <= set(mesh.point_data)
+
+
+def test_radial_study_writes_error_against_runtime(tmp_path):
+    from wendel.study import study
+
+    root = study(WORKFLOWS / "obstacle-radial.toml", levels=3, smoke=True, out=tmp_path / "study",
+                 progress=lambda *_: None)
+    with open(root / "study.csv") as f:
+        rows = list(csv.DictReader(f))
+    assert [int(r["dofs"]) for r in rows] == [17 ** 2, 33 ** 2, 65 ** 2]
+    assert float(rows[-1]["rate_h1_relative"]) > 0.9
+    assert (root / "error_vs_runtime.png").stat().st_size > 10000
