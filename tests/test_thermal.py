@@ -7,12 +7,12 @@ Tolerances: 1e-6 relative for the homogeneous checks (exact for P1 up to round-o
 
 import csv
 import json
+import re
 
 import numpy as np
 import pytest
 
 from wendel import output
-from wendel.freefem import FreeFemError
 from wendel.run import run
 from wendel.study import study
 
@@ -47,3 +47,46 @@ def test_free_expansion(tmp_path):
         xyz = np.loadtxt(f, skiprows=1)
     assert np.abs(u - ALPHA * DT * xyz).max() <= 1e-6 * ALPHA * DT * np.abs(xyz).max()   # strain alpha dT
     assert last["newton_iterations"] <= 2                # staggered: heat, then mechanics
+
+
+def test_manufactured_coupled_solution_converges_at_the_element_order(tmp_path):
+    root = study(WORKFLOWS / "thermo-mms.toml", levels=3, smoke=True, out=tmp_path / "study", progress=lambda *_: None)
+    rows = list(csv.DictReader(open(root / "study.csv")))
+    assert abs(float(rows[-1]["rate_h1"]) - 1.0) < 0.2      # u, P1: H1 ~ h
+    assert abs(float(rows[-1]["rate_l2"]) - 2.0) < 0.2      # u: L2 ~ h^2
+    last = [_last(root / f"level-{k}") for k in range(3)]
+    for norm, order in (("l2", 2.0), ("h1", 1.0)):           # T, P1
+        e = [r[f"error_T_{norm}"] / r[f"reference_T_{norm}"] for r in last]
+        assert abs(np.log2(e[1] / e[2]) - order) < 0.2
+    assert all(r["newton_iterations"] == 1 for r in last)  # monolithic Newton on a linear coupled problem
+    assert all(r["energy_balance_error"] <= 0.01 for r in last)
+
+
+def test_adiabatic_johnson_cook_bar(tmp_path):
+    root = run(WORKFLOWS / "thermo-adiabatic-bar.toml", smoke=True, out=tmp_path / "r", png=False, progress=lambda *_: None)
+    last = _last(root)
+    rho, c, beta, A, B, n = 7830.0, 477.0, 0.9, 792e6, 510e6, 0.26
+    p = last["max_plastic_strain"]
+    assert p == pytest.approx(1.0, abs=1e-9)
+    rise = last["max_temperature"] - 293.15
+    assert last["max_temperature"] - last["min_temperature"] <= 1e-9 * rise     # homogeneous
+    volume = 1.0
+    assert rise == pytest.approx(beta / (rho * c) * last["plastic_work"] / volume, rel=1e-9)
+    exact = beta / (rho * c) * (A * p + B * p ** (n + 1) / (n + 1))              # 288.4 K
+    assert rise == pytest.approx(exact, rel=5e-3)                              # trapezoidal rule over 40 steps
+    assert last["energy_balance_error"] <= 0.01
+    assert last["jc_clipped_points"] == 0
+
+
+def test_adiabatic_without_plasticity_is_refused(tmp_path, scene_file):
+    text = (WORKFLOWS / "thermo-free.toml").read_text().replace('coupling = "staggered"', 'coupling = "adiabatic"')
+    with pytest.raises(ValueError, match=re.escape("it needs a [plasticity] block")):
+        run(scene_file(text), smoke=True, out=tmp_path / "r", png=False, progress=lambda *_: None)
+
+
+def test_steady_heat_without_temperature_boundary_is_refused(scene_file):
+    from wendel.scene import SceneError, load
+
+    text = (WORKFLOWS / "thermo-free.toml").read_text().split("[thermal.boundary.left]")[0] + "\n[loading]\nsteps = 1\n"
+    with pytest.raises(SceneError, match="needs a temperature or convection boundary"):
+        load(scene_file(text))
