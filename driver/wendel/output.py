@@ -110,7 +110,10 @@ def picture(vtu: Path, png: Path, title: str, warp: float = 0.0, field: str | No
         u = grid.point_data["u"]
         size = max(np.ptp(grid.points, axis=0))
         umax = float(np.abs(u).max()) or 1.0
-        scale = warp or 0.1 * size / umax
+        # true scale for visible deformations and remeshed bodies (their mesh is already the deformed
+        # body), magnified to 10% of the size for small ones
+        large = umax >= 0.05 * size or "u_total" in grid.point_data
+        scale = warp or (1.0 if large else 0.1 * size / umax)
         grid = grid.warp_by_vector("u", factor=scale)
         title = f"{title} (displacement x{scale:.3g})"
     field = field or ("vonMises" if "vonMises" in grid.cell_data else None)

@@ -77,6 +77,19 @@ def append_history(root: Path, record: dict, newton_csv: Path) -> None:
             f.write("\n".join(rows if header else rows[1:]) + "\n")
 
 
+def truncate_history(root: Path, last_increment: int) -> None:
+    """Drop history and Newton rows past ``last_increment`` (a resumed run writes them again)."""
+    for name in ("history.csv", "newton.csv"):
+        path = root / name
+        if not path.is_file():
+            continue
+        lines = path.read_text().splitlines()
+        keep = lines[:1] + [l for l in lines[1:] if int(float(l.split(",", 1)[0])) <= last_increment]
+        tmp = path.with_suffix(".tmp")
+        tmp.write_text("\n".join(keep) + "\n")
+        os.replace(tmp, path)
+
+
 def read_records(root: Path) -> list[dict]:
     """record.json of every accepted increment, in order."""
     return [json.loads((d / "record.json").read_text())
@@ -129,6 +142,7 @@ def write_summary(root: Path, scene, state, dimension: int) -> dict:
         "wall_time_by_phase": phases,
         "share_startup_and_io": (phases["freefem_startup"] + phases["freefem_output"] + phases["driver_output"]) / total
         if total else None,
+        "remeshes": state.remeshes,
         "errors": {k: v for k, v in last.items() if k.startswith("error_") and isinstance(v, (int, float)) and v >= 0},
         "last_increment": last,
     }

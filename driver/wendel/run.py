@@ -14,7 +14,7 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from . import freefem, output, report
+from . import freefem, output, remeshing, report
 from .blocks import BLOCKS, PROBLEMS
 from .meshes import LABELS, build as build_mesh
 from .schema import ANALYTIC_REFERENCES, BODY_FORCES, Scene
@@ -61,6 +61,11 @@ class State:
     accepted: list[tuple[int, float]] = field(default_factory=list)
     pending: list[float] = field(default_factory=list)
     cuts: int = 0
+    # meshes of the run: from increment `first` on, mesh file, base displacement and pre-strain files
+    segments: list[dict] = field(default_factory=lambda: [{"first": 1, "mesh": "mesh.msh", "ubase": None, "eps0": None}])
+    remeshes: list[dict] = field(default_factory=list)
+    reequilibrate: bool = False
+    quality: dict = field(default_factory=dict)
     launches: list[dict] = field(default_factory=list)
     mesh_seconds: float = 0.0
     post_seconds: float = 0.0
@@ -68,6 +73,10 @@ class State:
     @property
     def last(self) -> tuple[int, float]:
         return self.accepted[-1] if self.accepted else (0, 0.0)
+
+    def segment(self, inc: int) -> dict:
+        """The mesh segment increment ``inc`` belongs to."""
+        return [s for s in self.segments if s["first"] <= inc][-1]
 
 
 def run(scene_path: str | Path, smoke: bool = False, ranks: int | None = None, out: Path | None = None,
@@ -111,6 +120,8 @@ def _execute(scene: Scene, files: RunFiles, state: State, progress) -> Path:
     progress(f"wendel: {scene.description}")
     progress(f"  run folder {files.root}")
     try:
+        if scene.remesh and state.accepted and state.pending and not state.reequilibrate:
+            maybe_remesh(scene, files, state, dimension, progress)    # a run resumed before the decision
         solve(scene, files, state, dimension, progress)
     finally:
         report.write_summary(files.root, scene, state, dimension)
@@ -137,54 +148,113 @@ def build(scene: Scene, files: RunFiles) -> tuple[float, int]:
 
 
 def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress) -> None:
-    """Launch FreeFEM on the pending increments; on a Newton failure halve the step and go on."""
+    """Launch FreeFEM on the pending increments; cut failing steps; remesh when the mesh distorts.
+
+    Without remeshing one launch runs all pending increments (start-up paid once); with remeshing each
+    launch runs one increment so that the driver judges the mesh after every increment.
+    """
     write_tables(scene, files, dimension)
     entry = entry_script(scene, dimension)
     while state.pending:
         inc0 = state.last[0] + 1
+        batch = state.pending[:1] if scene.remesh else list(state.pending)
         loads = files.tables / "loads.txt"
-        loads.write_text(f"{len(state.pending)}\n" + "".join(f"{lf!r}\n" for lf in state.pending))
-        opts = options(scene, files, dimension) + ["-loads", str(loads), "-inc0", str(inc0)]
-        if state.accepted:
+        loads.write_text(f"{len(batch)}\n" + "".join(f"{lf!r}\n" for lf in batch))
+        seg = state.segment(inc0)
+        opts = options(scene, files, dimension, seg) + ["-loads", str(loads), "-inc0", str(inc0)]
+        if state.reequilibrate:
+            opts += ["-restart", str(files.root / seg["state"])]
+        elif state.accepted:
             opts += ["-restart", str(files.fem / f"inc-{state.last[0]:04d}")]
-        watcher = _Progress(files.fem, inc0, len(state.pending), state.pending, progress)
-        failure = None
+        watcher = _Progress(files.fem, inc0, len(batch), batch, progress)
+        failure, before, t0 = None, len(state.accepted), time.perf_counter()
         try:
             with watcher:
-                launch = freefem.run(entry, opts, files.fem, ranks=scene.numerics.ranks,
-                                     timeout=scene.numerics.timeout, log=files.root / "freefem.log")
-            state.launches.append({"wall": launch.wall, "increments": len(state.pending)})
+                freefem.run(entry, opts, files.fem, ranks=scene.numerics.ranks,
+                            timeout=scene.numerics.timeout, log=files.root / "freefem.log")
         except freefem.NewtonFailure as exc:
             failure = exc
-            state.launches.append({"wall": time.perf_counter() - watcher.t0, "increments": None})
         finally:
             accept(scene, files, state, dimension)
-        if failure is None:
-            break
-        cut_step(scene, files, state, failure, progress)
+            state.launches.append({"wall": time.perf_counter() - t0, "increments": len(state.accepted) - before,
+                                   "complete": failure is None})
+        if failure is not None:
+            cut_step(scene, files, state, failure, progress)
+            _save_checkpoint(files, scene, state, dimension)
+            continue
+        if state.reequilibrate:
+            state.reequilibrate = False
+            rep = state.remeshes[-1]
+            remeshing.finish_report(rep, files.fem / f"inc-{state.last[0]:04d}",
+                                    files.root / "remesh" / f"remesh-{len(state.remeshes)}.json")
+            progress(f"  re-equilibrated on the new mesh: relative residual {rep['residual_after_transfer']:.2e}"
+                     f" -> {rep['residual_after_reequilibration']:.2e}")
+        elif scene.remesh and state.pending:
+            maybe_remesh(scene, files, state, dimension, progress)
         _save_checkpoint(files, scene, state, dimension)
 
 
+def maybe_remesh(scene: Scene, files: RunFiles, state: State, dimension: int, progress) -> None:
+    """Remesh after the last accepted increment when its deformed mesh is too poor (or asked)."""
+    r = scene.remesh
+    inc, lf = state.last
+    if state.segments[-1]["first"] > inc:
+        return      # already remeshed after this increment (a resumed run)
+    q = state.quality.get(inc, {})
+    poor = q.get("min_quality", 1.0) < r.min_quality or q.get("inverted", 0) > 0
+    if not (poor or inc in r.at):
+        return
+    if len(state.remeshes) >= r.max_remeshes:
+        if poor:
+            progress(f"  increment {inc}: mesh quality {q['min_quality']:.3g} but remesh.max_remeshes "
+                     f"= {r.max_remeshes} reached; going on without remeshing")
+        return
+    k = len(state.remeshes) + 1
+    seg = state.segment(inc)
+    h = r.h or scene.geometry.h
+    mesh_new = f"meshes/mesh-{k}.msh"
+    state_dir = f"remesh/state-{k}"
+    ubase_old = output.read_array(files.root / seg["ubase"]) if seg["ubase"] else None
+    progress(f"  increment {inc}: min quality {q.get('min_quality', float('nan')):.3g}"
+             f"{' (asked by remesh.at)' if not poor else ''}: remeshing")
+    rep = remeshing.remesh_state(files.fem / f"inc-{inc:04d}", files.root / seg["mesh"], ubase_old, dimension,
+                                 files.root / mesh_new, files.root / state_dir, h, r.h_min or h / 3, r.indicator)
+    rep.update({"remesh": k, "after_increment": inc, "load_factor": lf})
+    state.remeshes.append(rep)
+    state.segments.append({"first": inc + 1, "mesh": mesh_new, "ubase": f"{state_dir}/ubase.txt",
+                           "eps0": f"{state_dir}/eps0.txt", "state": state_dir})
+    state.pending.insert(0, lf)
+    state.reequilibrate = True
+
+
 def accept(scene: Scene, files: RunFiles, state: State, dimension: int) -> None:
-    """Take the committed increments FreeFEM wrote: VTU, histories, checkpoint."""
+    """Take the committed increments FreeFEM wrote: VTU, mesh quality, histories, checkpoint."""
     t0 = time.perf_counter()
-    points = cells = None
+    meshes: dict[str, tuple] = {}
     while state.pending:
         inc = state.last[0] + 1
         d = files.fem / f"inc-{inc:04d}"
         if not (d / "done").is_file():
             break
         record = json.loads((d / "record.json").read_text())
-        if scene.output.vtu:
-            if points is None:
-                points, cells = output.read_mesh(files.mesh, dimension)
+        seg = state.segment(inc)
+        if seg["mesh"] not in meshes:
+            points, cells = output.read_mesh(files.root / seg["mesh"], dimension)
+            if seg["first"] == inc:
                 output.check_node_order(files.fem / "vertices.txt", points)
+            meshes[seg["mesh"]] = (points, cells)
+        points, cells = meshes[seg["mesh"]]
+        extra = {"reequilibration": int(state.reequilibrate and inc == seg["first"] and inc > 1)}
+        if scene.problem == "mechanics":
+            extra.update(remeshing.judge(points, cells, output.read_array(d / "u.node.txt"), dimension))
+            state.quality[inc] = extra
+        if scene.output.vtu:
             pdata, cdata = output.increment_fields(d, len(points), len(cells), dimension)
             files.vtu.mkdir(exist_ok=True)
             output.write_vtu(files.vtu / f"inc-{inc:04d}.vtu", points, cells, dimension, pdata, cdata)
         state.accepted.append((inc, record["load_factor"]))
         state.pending.pop(0)
-        report.append_history(files.root, record, d / "newton.csv")
+        report.append_history(files.root, {**record, **extra}, d / "newton.csv")
         _save_checkpoint(files, scene, state, dimension)
     if scene.output.vtu and state.accepted:
         output.write_pvd(files.root / "results.pvd",
@@ -228,10 +298,11 @@ def entry_script(scene: Scene, dimension: int) -> str:
     return f"solve-{dimension}d{tags}.edp"
 
 
-def options(scene: Scene, files: RunFiles, dimension: int) -> list[str]:
-    """FreeFEM options of the scene: numbers and integer ids only."""
+def options(scene: Scene, files: RunFiles, dimension: int, segment: dict | None = None) -> list[str]:
+    """FreeFEM options of the scene: numbers and integer ids only (and file paths the driver made)."""
     n = scene.numerics
-    opts = ["-mesh", str(files.mesh), "-solver", n.solver, "-solver_tol", repr(n.solver_tol),
+    segment = segment or {"mesh": "mesh.msh", "ubase": None, "eps0": None}
+    opts = ["-mesh", str(files.root / segment["mesh"]), "-solver", n.solver, "-solver_tol", repr(n.solver_tol),
             "-newton_tol", repr(n.newton_tol), "-newton_maxit", str(n.newton_maxit)]
     if scene.problem != "mechanics":
         return opts + PROBLEMS[scene.problem].options(scene, files, dimension)
@@ -239,6 +310,9 @@ def options(scene: Scene, files: RunFiles, dimension: int) -> list[str]:
     opts += ["-mat_E", repr(m.E), "-mat_nu", repr(m.nu),
              "-el_plane_stress", "1" if scene.elasticity.plane == "stress" else "0",
              "-bc", str(files.tables / "bc.txt"), "-trac", str(files.tables / "trac.txt")]
+    for key in ("ubase", "eps0"):
+        if segment.get(key):
+            opts += [f"-{key}", str(files.root / segment[key])]
     bf = scene.body_force
     v = list(bf.value) + [0.0] * (3 - len(bf.value))
     opts += ["-body_id", str(BODY_FORCES[bf.kind]), "-body_fx", repr(v[0]), "-body_fy", repr(v[1]),
@@ -281,6 +355,8 @@ def _new_run_dir(scene_path: Path, smoke: bool) -> Path:
 def _save_checkpoint(files: RunFiles, scene: Scene, state: State, dimension: int) -> None:
     data = {"scene": scene.model_dump(mode="json"), "dimension": dimension,
             "accepted": state.accepted, "pending": state.pending, "cuts": state.cuts,
+            "segments": state.segments, "remeshes": state.remeshes, "reequilibrate": state.reequilibrate,
+            "quality": {str(k): v for k, v in state.quality.items()},
             "launches": state.launches, "mesh_seconds": state.mesh_seconds, "post_seconds": state.post_seconds}
     tmp = files.checkpoint.with_suffix(".tmp")
     tmp.write_text(json.dumps(data, indent=1))
@@ -294,8 +370,11 @@ def _resume(root: Path) -> tuple[RunFiles, Scene, State]:
     data = json.loads(files.checkpoint.read_text())
     scene = Scene.model_validate(data["scene"])
     state = State(accepted=[tuple(a) for a in data["accepted"]], pending=data["pending"], cuts=data["cuts"],
-                  launches=data["launches"], mesh_seconds=data["mesh_seconds"], post_seconds=data["post_seconds"])
+                  launches=data["launches"], mesh_seconds=data["mesh_seconds"], post_seconds=data["post_seconds"],
+                  segments=data["segments"], remeshes=data["remeshes"], reequilibrate=data["reequilibrate"],
+                  quality={int(k): v for k, v in data["quality"].items()})
     # An increment committed after the last checkpoint is taken as it is; a partial one is dropped.
+    report.truncate_history(files.root, state.last[0])
     accept(scene, files, state, data["dimension"])
     nxt = files.fem / f"inc-{state.last[0] + 1:04d}"
     if nxt.is_dir():

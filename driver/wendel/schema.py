@@ -10,6 +10,7 @@ Lengths in m, stresses and moduli in Pa, forces per volume in N/m^3, times in s.
 from __future__ import annotations
 
 import inspect
+import typing
 from typing import Literal, Optional
 
 from pydantic import BaseModel, ConfigDict, Field, create_model, field_validator, model_validator
@@ -154,6 +155,18 @@ class Output(Strict):
     warp: float = Field(0.0, ge=0, description="displacement scale of the picture; 0 = automatic")
 
 
+class Remesh(Strict):
+    """Remeshing of the deformed body (its presence enables it): when the deformed mesh's quality falls
+    below the threshold, gmsh meshes the deformed configuration anew and the state is transferred."""
+
+    min_quality: float = Field(0.1, gt=0, lt=1, description="remesh when the min SICN of the deformed mesh falls below [1]")
+    h: Optional[float] = Field(None, gt=0, description="element size of the new meshes [m]; default geometry.h")
+    h_min: Optional[float] = Field(None, gt=0, description="smallest size where the indicator peaks [m]; default h/3")
+    indicator: str = Field("p", description="cell field that grades the size (e.g. p); empty: uniform size")
+    max_remeshes: int = Field(20, ge=0, description="remeshes allowed in one run")
+    at: list[int] = Field(default_factory=list, description="increments after which to remesh whatever the quality")
+
+
 class Reference(Strict):
     """What errors are measured against: an analytic field, errors a module computes against a closed
     form (record.json keys ``error_*``), or else the finest run of a study."""
@@ -211,6 +224,7 @@ class SceneBase(Strict):
     loading: Loading = Loading()
     numerics: Numerics = Numerics()
     output: Output = Output()
+    remesh: Optional[Remesh] = Field(None, description="present: remesh the deformed body when it distorts")
     reference: Reference = Reference()
     smoke: Smoke = Smoke()
 
@@ -256,11 +270,9 @@ def _describe(model: type[BaseModel], prefix: str) -> list[tuple[str, str, str, 
             continue
         args = getattr(ann, "__args__", ())
         sub = [a for a in args if isinstance(a, type) and issubclass(a, BaseModel)]
-        if sub and name in BLOCKS:
-            rows += _describe(sub[0], f"{prefix}{name}.")
-            continue
-        if sub:   # dict of tables, e.g. boundary.<name>
-            rows += _describe(sub[0], f"{prefix}{name}.<name>.")
+        if sub:   # an optional table, or a dict of tables such as boundary.<name>
+            named = typing.get_origin(ann) is dict
+            rows += _describe(sub[0], f"{prefix}{name}.{'<name>.' if named else ''}")
             continue
         rng = ", ".join(f"{type(m).__name__.lower()} {getattr(m, type(m).__name__.lower(), '')}"
                         for m in f.metadata if type(m).__name__ in ("Gt", "Ge", "Lt", "Le"))

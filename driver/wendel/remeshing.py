@@ -1,0 +1,147 @@
+"""The driver's remeshing step: judge the deformed mesh, mesh it anew, carry the state over.
+
+After an accepted increment on a mesh with reference coordinates X and displacement u (since that
+mesh was made), the deformed mesh X + u is judged by its element quality (:mod:`wendel.quality`). When
+it is too poor (or the scene asks for a remesh at that increment), gmsh meshes the deformed body anew
+(:mod:`wendel.remesh`) and the state is interpolated onto the new mesh (:mod:`wendel.transfer`):
+
+- displacement: the total displacement reached (``u_total = ubase + u``) becomes the new ``ubase``
+  (Dirichlet values are measured from the original body); ``u`` restarts at zero;
+- total strain (``strain.cell.txt``) becomes the pre-strain ``eps0`` of the new mesh, so the stress
+  state is kept;
+- module state: nodal files (``*.node.txt``, e.g. temperature) are interpolated; quadrature-point
+  files (``*.qp.txt``, component-major, one point per element with P1) are recovered to nodes by a
+  volume-weighted average (which keeps their integral), interpolated and averaged on the new cells;
+  other state files (``*.txt``) are copied.
+
+The driver then re-equilibrates at the same load factor before the next increment; the transfer
+report (``remesh/remesh-K.json``) records the residual before and after, the change of the integral
+and extrema of p, the quality before and after, and the times.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import shutil
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from . import output, quality, remesh, transfer
+
+SKIP_NODE = {"u", "u_total"}
+
+
+def judge(points: np.ndarray, cells: np.ndarray, u: np.ndarray, dimension: int) -> dict:
+    """Quality of the deformed mesh X + u (u interleaved per node)."""
+    deformed = points[:, :dimension] + u.reshape(len(points), dimension)
+    q = quality.mesh_quality(deformed, cells, reference=points[:, :dimension])
+    return {"min_quality": q["min"], "mean_quality": q["mean"], "inverted": q["inverted"]}
+
+
+def cell_volumes(points: np.ndarray, cells: np.ndarray) -> np.ndarray:
+    """Unsigned areas (2D) or volumes (3D)."""
+    return np.abs(quality.signed_measure(points, cells))
+
+
+def remesh_state(inc_dir: Path, mesh_old: Path, ubase_old: np.ndarray | None, dimension: int,
+                 mesh_new: Path, state_new: Path, h: float, h_min: float, indicator: str) -> dict:
+    """Mesh the deformed body of increment ``inc_dir`` anew and write the transferred state.
+
+    Writes ``mesh_new`` and, in ``state_new``, ``u.node.txt`` (zeros), ``ubase.txt``, ``eps0.txt`` and the
+    module state files; returns the transfer report (without the re-equilibration residuals).
+    """
+    t0 = time.perf_counter()
+    X, cells = output.read_mesh(mesh_old, dimension)
+    X = X[:, :dimension]
+    n_old = len(X)
+    u = output.read_array(inc_dir / "u.node.txt")
+    xd = X + u.reshape(n_old, dimension)
+    before = quality.mesh_quality(xd, cells, reference=X)
+    cellfield = lambda name: _cells(inc_dir / f"{name}.cell.txt", len(cells))
+    size_ind = None
+    if indicator and (inc_dir / f"{indicator}.cell.txt").is_file():
+        size_ind = transfer.cell_to_nodes(xd, cells, cellfield(indicator)[:, 0])
+    with _quiet_stdout():
+        info = remesh.remesh(xd, mesh_old, mesh_new, h, size_indicator=size_ind, h_min=h_min)
+    t1 = time.perf_counter()
+    Y, new_cells = output.read_mesh(mesh_new, dimension)
+    Y = Y[:, :dimension]
+    state_new.mkdir(parents=True, exist_ok=True)
+    report = {"old_nodes": n_old, "old_elements": len(cells), "new_nodes": len(Y), "new_elements": len(new_cells),
+              "min_quality_before": before["min"], "inverted_before": before["inverted"],
+              "min_quality_after": info["min_sicn"], "measure_old": info["measure_old"],
+              "measure_new": info["measure_new"], "remesh_seconds": t1 - t0}
+    utot = u + (ubase_old if ubase_old is not None else 0.0)
+    new_ubase, outside = transfer.transfer_nodal(xd, cells, utot, Y)
+    output.write_array(state_new / "ubase.txt", new_ubase)
+    output.write_array(state_new / "u.node.txt", np.zeros(len(Y) * dimension))
+    strain = cellfield("strain")
+    output.write_array(state_new / "eps0.txt", transfer.transfer_cell(xd, cells, strain, Y, new_cells)[0])
+    report["nodes_outside_old_mesh"] = int(outside)
+    vol_old, vol_new = cell_volumes(xd, cells), cell_volumes(Y, new_cells)
+    for f in sorted(inc_dir.glob("*.node.txt")):
+        name = f.name.removesuffix(".node.txt")
+        if name in SKIP_NODE:
+            continue
+        v, _ = transfer.transfer_nodal(xd, cells, output.read_array(f), Y)
+        output.write_array(state_new / f.name, v)
+    for f in sorted(inc_dir.glob("*.qp.txt")):
+        v = output.read_array(f)
+        if v.size % len(cells):
+            raise ValueError(f"{f}: {v.size} values are not a whole number per element; cannot transfer")
+        comps = v.size // len(cells)
+        per_cell = v.reshape(comps, len(cells)).T
+        new = transfer.transfer_cell(xd, cells, per_cell, Y, new_cells)[0].reshape(len(new_cells), comps)
+        output.write_array(state_new / f.name, new.T.ravel())
+        if f.name.endswith("_p.qp.txt") or f.name == "p.qp.txt":
+            report["integral_p_before"] = float(vol_old @ per_cell[:, 0])
+            report["integral_p_after"] = float(vol_new @ new[:, 0])
+            report["max_p_before"] = float(per_cell[:, 0].max())
+            report["max_p_after"] = float(new[:, 0].max())
+    for f in sorted(inc_dir.glob("*.txt")):
+        if not f.name.endswith((".node.txt", ".cell.txt", ".qp.txt")) and not (state_new / f.name).exists():
+            shutil.copyfile(f, state_new / f.name)
+    report["transfer_seconds"] = time.perf_counter() - t1
+    return report
+
+
+@contextlib.contextmanager
+def _quiet_stdout():
+    """gmsh's C++ side prints blank lines to file descriptor 1 whatever its options: send them away."""
+    sys.stdout.flush()
+    saved = os.dup(1)
+    try:
+        with open(os.devnull, "w") as null:
+            os.dup2(null.fileno(), 1)
+            yield
+    finally:
+        sys.stdout.flush()
+        os.dup2(saved, 1)
+        os.close(saved)
+
+
+def _cells(path: Path, n_cells: int) -> np.ndarray:
+    v = output.read_array(path)
+    return v.reshape(n_cells, -1)
+
+
+def finish_report(report: dict, reeq_dir: Path, path: Path) -> dict:
+    """Add the re-equilibration residuals (first and last Newton rows) and write the report."""
+    rows = [r.split(",") for r in (reeq_dir / "newton.csv").read_text().splitlines()]
+    head, rows = rows[0], rows[1:]
+    col = head.index("relative_residual")
+    report["residual_after_transfer"] = float(rows[0][col])
+    report["residual_after_reequilibration"] = float(rows[-1][col])
+    report["reequilibration_iterations"] = len(rows) - 1
+    rec = json.loads((reeq_dir / "record.json").read_text())
+    for key in ("contact_force", "max_plastic_strain", "plastic_points"):
+        if key in rec:
+            report[f"{key}_after"] = rec[key]
+    path.parent.mkdir(exist_ok=True)
+    path.write_text(json.dumps(report, indent=1))
+    return report
