@@ -90,3 +90,17 @@ def test_steady_heat_without_temperature_boundary_is_refused(scene_file):
     text = (WORKFLOWS / "thermo-free.toml").read_text().split("[thermal.boundary.left]")[0] + "\n[loading]\nsteps = 1\n"
     with pytest.raises(SceneError, match="needs a temperature or convection boundary"):
         load(scene_file(text))
+
+
+def test_heated_ball_on_elastic_block_energy_balance(tmp_path, scene_file):
+    """thermo-indent without plasticity: contact heat from the tool, Gough-Joule heat, cold table."""
+    text = (WORKFLOWS / "thermo-indent.toml").read_text()
+    text = text[:text.index("[plasticity]")] + text[text.index("[contact]"):]
+    root = run(scene_file(text), smoke=True, out=tmp_path / "r", png=False, progress=lambda *_: None)
+    last = _last(root)
+    assert last["heat_contact"] > 0 and last["contact_active_nodes"] > 0
+    assert 293.15 < last["max_temperature"] < 800.0                  # below the tool temperature
+    assert last["energy_balance_error"] <= 0.01
+    stored = last["thermal_energy_change"]
+    sources = last["heat_contact"] + last["heat_boundary"] + last["heat_thermoelastic"] + last["heat_plastic"]
+    assert abs(stored - sources) <= 0.01 * abs(stored)
