@@ -106,7 +106,15 @@ def picture(vtu: Path, png: Path, title: str, warp: float = 0.0, field: str | No
 
     pv.OFF_SCREEN = True
     grid = pv.read(vtu)
-    if "u" in grid.point_data:
+    if "u" in grid.point_data and np.ndim(grid.point_data["u"]) == 1:
+        # a scalar field on a plane (membrane, torsion): show it as a surface z = u
+        u = np.asarray(grid.point_data["u"])
+        size = max(np.ptp(np.asarray(grid.points), axis=0))
+        scale = warp or (0.3 * size / (float(np.abs(u).max()) or 1.0))
+        grid = grid.warp_by_scalar("u", factor=scale, normal=(0, 0, 1))
+        field = field or "u"
+        title = f"{title} (u x{scale:.3g} upwards)"
+    elif "u" in grid.point_data:
         u = grid.point_data["u"]
         size = max(np.ptp(grid.points, axis=0))
         umax = float(np.abs(u).max()) or 1.0

@@ -80,11 +80,13 @@ class State:
 
 
 def run(scene_path: str | Path, smoke: bool = False, ranks: int | None = None, out: Path | None = None,
-        resume: Path | None = None, progress=print, h: float | None = None, png: bool | None = None) -> Path:
+        resume: Path | None = None, progress=print, h: float | None = None, png: bool | None = None,
+        scale: float | None = None) -> Path:
     """Run the scene file ``scene_path``; return the run folder (results/<scene>/<run-id>/).
 
-    ``ranks``, ``h`` and ``png`` override numerics.ranks, geometry.h and output.png; ``resume`` continues
-    the run folder given from its last checkpoint.
+    ``ranks``, ``h`` and ``png`` override numerics.ranks, geometry.h and output.png; ``scale`` multiplies
+    geometry.h and the size of a refined zone (geometry.refine.h); ``resume`` continues the run folder
+    given from its last checkpoint.
     """
     if resume is not None:
         files, scene, state = _resume(Path(resume))
@@ -94,6 +96,11 @@ def run(scene_path: str | Path, smoke: bool = False, ranks: int | None = None, o
     scene = load(scene_path, smoke=smoke)
     if h is not None:
         scene.geometry.h = h
+    if scale is not None:
+        scene.geometry.h *= scale
+        refine = (scene.geometry.model_extra or {}).get("refine")
+        if isinstance(refine, dict) and "h" in refine:
+            refine["h"] *= scale
     if png is not None:
         scene.output.png = png
     if ranks is not None:

@@ -1,6 +1,7 @@
 """Error against run time over a sequence of refined meshes (``wendel study SCENE --levels K``).
 
-Level k runs the scene with element size h / 2^k. The error is against the scene's analytic
+Level k runs the scene with element size h / 2^k (and the size of a refined zone, ``geometry.refine.h``,
+scaled alike). The error is against the scene's analytic
 reference (relative L2 and H1 norms computed by FreeFEM with a high-order quadrature) when it
 declares one, else against the finest run's ``reference.quantity``. Writes study.csv and
 error_vs_runtime.png (log-log, observed convergence rates in the legend).
@@ -46,7 +47,7 @@ def study(scene_path: str | Path, levels: int = 3, smoke: bool = False, ranks: i
     for k in range(levels):
         h = scene.geometry.h / 2 ** k
         progress(f"study level {k + 1}/{levels}: h = {h:g}")
-        run_dir = run(scene_path, smoke=smoke, ranks=ranks, out=root / f"level-{k}", h=h, png=False,
+        run_dir = run(scene_path, smoke=smoke, ranks=ranks, out=root / f"level-{k}", scale=0.5 ** k, png=False,
                       progress=lambda *_: None)
         s = json.loads((run_dir / "summary.json").read_text())
         last = s["last_increment"]
@@ -55,19 +56,20 @@ def study(scene_path: str | Path, levels: int = 3, smoke: bool = False, ranks: i
                      + s["wall_time_by_phase"]["constitutive"],
                      "newton_iterations": s["newton_iterations"], "last": last})
     analytic = scene.reference.analytic is not None or bool(scene.reference.errors)
+    names = []
     if scene.reference.analytic is not None:
         for r in rows:
             r["error_l2"] = r["last"]["error_l2"] / r["last"]["reference_l2"]
             r["error_h1"] = r["last"]["error_h1"] / r["last"]["reference_h1"]
         names = ["error_l2", "error_h1"]
-    elif scene.reference.errors:
-        names = list(scene.reference.errors)
+    if scene.reference.errors:
+        names += list(scene.reference.errors)
         for r in rows:
             for name in names:
                 if name not in r["last"]:
                     raise KeyError(f"reference.errors: {name!r} is not in record.json of level {r['level']}")
                 r[name] = abs(r["last"][name])
-    else:
+    if not analytic:
         q = scene.reference.quantity
         ref = rows[-1]["last"].get(q)
         if ref is None:
