@@ -191,3 +191,17 @@ def ring(path: Path, r_inner=1.0, r_outer=1.3, h=0.05, quarter=True) -> Built:
             gmsh.model.addPhysicalGroup(1, groups[n], LABELS[n], n)
         gmsh.model.addPhysicalGroup(2, [t for _, t in gmsh.model.getEntities(2)], LABELS["domain"], "domain")
         return _write(gmsh, path, 2, names)
+
+
+@register("disk")
+def disk(path: Path, radius=1.0, center=(0.0, 0.0), h=0.1) -> Built:
+    """A full disk of ``radius`` (m) around ``center``: a bar's circular cross-section; boundary outer."""
+    with _Session("disk") as gmsh:
+        occ = gmsh.model.occ
+        occ.addDisk(center[0], center[1], 0, radius, radius)
+        occ.synchronize()
+        _size_field(gmsh, h, None)
+        curves = [c for _, c in gmsh.model.getEntities(1)]
+        gmsh.model.addPhysicalGroup(1, curves, LABELS["outer"], "outer")
+        gmsh.model.addPhysicalGroup(2, [t for _, t in gmsh.model.getEntities(2)], LABELS["domain"], "domain")
+        return _write(gmsh, path, 2, ["outer"])
