@@ -76,33 +76,42 @@ def remesh_state(inc_dir: Path, mesh_old: Path, ubase_old: np.ndarray | None, di
               "min_quality_before": before["min"], "inverted_before": before["inverted"],
               "min_quality_after": info["min_sicn"], "measure_old": info["measure_old"],
               "measure_new": info["measure_new"], "remesh_seconds": t1 - t0}
+    # Every field goes through one point location: nodal fields as they are, cell fields recovered
+    # to nodes (volume-weighted, integral kept), all stacked, interpolated once, split again.
     utot = u + (ubase_old if ubase_old is not None else 0.0)
-    new_ubase, outside = transfer.transfer_nodal(xd, cells, utot, Y)
-    output.write_array(state_new / "ubase.txt", new_ubase)
-    output.write_array(state_new / "u.node.txt", np.zeros(len(Y) * dimension))
-    strain = cellfield("strain")
-    output.write_array(state_new / "eps0.txt", transfer.transfer_cell(xd, cells, strain, Y, new_cells)[0])
-    report["nodes_outside_old_mesh"] = int(outside)
-    vol_old, vol_new = cell_volumes(xd, cells), cell_volumes(Y, new_cells)
+    fields = [("node", "ubase.txt", utot.reshape(n_old, dimension)),
+              ("cell", "eps0.txt", transfer.cell_to_nodes(xd, cells, cellfield("strain")))]
     for f in sorted(inc_dir.glob("*.node.txt")):
-        name = f.name.removesuffix(".node.txt")
-        if name in SKIP_NODE:
-            continue
-        v, _ = transfer.transfer_nodal(xd, cells, output.read_array(f), Y)
-        output.write_array(state_new / f.name, v)
+        if f.name.removesuffix(".node.txt") not in SKIP_NODE:
+            fields.append(("node", f.name, output.read_array(f).reshape(n_old, -1)))
+    qp_cells = {}
     for f in sorted(inc_dir.glob("*.qp.txt")):
         v = output.read_array(f)
         if v.size % len(cells):
             raise ValueError(f"{f}: {v.size} values are not a whole number per element; cannot transfer")
-        comps = v.size // len(cells)
-        per_cell = v.reshape(comps, len(cells)).T
-        new = transfer.transfer_cell(xd, cells, per_cell, Y, new_cells)[0].reshape(len(new_cells), comps)
-        output.write_array(state_new / f.name, new.T.ravel())
-        if f.name.endswith("_p.qp.txt") or f.name == "p.qp.txt":
-            report["integral_p_before"] = float(vol_old @ per_cell[:, 0])
-            report["integral_p_after"] = float(vol_new @ new[:, 0])
-            report["max_p_before"] = float(per_cell[:, 0].max())
-            report["max_p_after"] = float(new[:, 0].max())
+        qp_cells[f.name] = v.reshape(v.size // len(cells), len(cells)).T
+        fields.append(("qp", f.name, transfer.cell_to_nodes(xd, cells, qp_cells[f.name])))
+    widths = [a.reshape(n_old, -1).shape[1] for _, _, a in fields]
+    stacked = np.hstack([a.reshape(n_old, -1) for _, _, a in fields])
+    moved, outside = transfer.transfer_nodal(xd, cells, stacked, Y)
+    report["nodes_outside_old_mesh"] = int(outside)
+    output.write_array(state_new / "u.node.txt", np.zeros(len(Y) * dimension))
+    vol_old, vol_new = cell_volumes(xd, cells), cell_volumes(Y, new_cells)
+    col = 0
+    for (kind, name, _), w in zip(fields, widths):
+        part = moved[:, col:col + w]
+        col += w
+        if kind == "node":
+            output.write_array(state_new / name, part)            # interleaved per node
+            continue
+        per_cell = transfer.nodes_to_cells(new_cells, part)
+        output.write_array(state_new / name, per_cell if kind == "cell" else per_cell.T)
+        if kind == "qp" and (name.endswith("_p.qp.txt") or name == "p.qp.txt"):
+            old = qp_cells[name][:, 0]
+            report["integral_p_before"] = float(vol_old @ old)
+            report["integral_p_after"] = float(vol_new @ per_cell[:, 0])
+            report["max_p_before"] = float(old.max())
+            report["max_p_after"] = float(per_cell[:, 0].max())
     for f in sorted(inc_dir.glob("*.txt")):
         if not f.name.endswith((".node.txt", ".cell.txt", ".qp.txt")) and not (state_new / f.name).exists():
             shutil.copyfile(f, state_new / f.name)
