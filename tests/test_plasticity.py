@@ -242,3 +242,22 @@ def test_cylinder_plastic_radius_and_limit_load(scene_file, tmp_path, quiet):
             c = math.sqrt(RI ** 2 + 4 * r["plastic_volume"] / math.pi)
             assert abs(c - hill_radius(q)) <= 0.02 * hill_radius(q), (q, c, hill_radius(q))
             assert abs(hill_pressure(c) - q) <= 0.02 * q
+
+
+def test_cylinder_scene_records_the_plastic_radius_error(tmp_path, quiet):
+    root = run(WORKFLOWS / "cylinder.toml", smoke=True, out=tmp_path / "run", png=False, progress=quiet)
+    recs = records(root / "fem")
+    assert recs[0]["error_plastic_radius"] == -1                  # 50 MPa: still elastic
+    for r in recs[1:]:
+        q = r["load_factor"] * 100e6
+        assert r["reference_plastic_radius"] == pytest.approx(hill_radius(q), rel=1e-9)
+        assert abs(r["plastic_radius"] - hill_radius(q)) <= 0.02 * hill_radius(q)
+    assert 0 < recs[-1]["error_plastic_radius"] < 0.15             # depth of the zone, h = 0.05 (measured 0.094)
+    s = json.loads((root / "summary.json").read_text())
+    assert "error_plastic_radius" in json.dumps(s)
+
+
+def test_hill_reference_needs_the_perfect_law(scene_file, tmp_path, quiet):
+    text = CYL_SCENE.replace('law = "perfect"', 'law = "linear"\nH = 1e9')
+    with pytest.raises(Exception, match="hill"):
+        run(scene_file(text), smoke=True, out=tmp_path / "run", png=False, progress=quiet)

@@ -39,6 +39,8 @@ class Plasticity(BaseModel):
     temperature: Optional[float] = Field(None, gt=0, description="uniform temperature without a thermal block [K]; default T_R")
     load_time: float = Field(0.0, ge=0, description="time per unit load factor, sets the strain rate [s]; 0 = quasi-static")
     limit_ratio: float = Field(1e-3, gt=0, lt=1, description="tangent/elastic stiffness ratio below which a failed increment of a perfectly plastic body is a limit load [1]")
+    reference: Optional[str] = Field(None, description="closed-form reference: hill (thick-walled cylinder under "
+                                     "internal pressure, perfect law, ring builder, pressure on inner): plastic radius")
 
     @field_validator("law")
     @classmethod
@@ -49,6 +51,8 @@ class Plasticity(BaseModel):
 
     @model_validator(mode="after")
     def _parameters(self):
+        if self.reference not in (None, "hill"):
+            raise ValueError(f"unknown plasticity reference {self.reference!r}; valid: hill")
         if self.law in ("perfect", "linear") and self.sigma0 is None:
             raise ValueError(f"plasticity.law = {self.law!r} needs sigma0")
         if self.law == "johnson-cook":
@@ -72,7 +76,20 @@ def options(block: Plasticity, scene, files) -> list[str]:
         opts += ["-plast_jc_A", repr(block.jc_A)]
     if block.temperature is not None:
         opts += ["-plast_T", repr(block.temperature)]
+    if block.reference == "hill":
+        opts += hill_options(block, scene)
     return opts
+
+
+def hill_options(block: Plasticity, scene) -> list[str]:
+    """``-plast_hill_*`` options: Hill's cylinder (pressure at load factor 1, inner and outer radii)."""
+    g, inner = scene.geometry, scene.boundary.get("inner")
+    if block.law != "perfect" or g.builder != "ring" or inner is None or not inner.pressure:
+        raise ValueError("plasticity.reference = 'hill' needs law = 'perfect', geometry.builder = 'ring' and "
+                         "a pressure on boundary.inner")
+    p = g.params
+    return ["-plast_hill_q", repr(float(inner.pressure)), "-plast_hill_a", repr(float(p.get("r_inner", 1.0))),
+            "-plast_hill_b", repr(float(p.get("r_outer", 1.3)))]
 
 
 register(Block(name="plasticity", model=Plasticity, options=options,
