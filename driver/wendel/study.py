@@ -68,7 +68,8 @@ def study(scene_path: str | Path, levels: int = 3, smoke: bool = False, ranks: i
             for name in names:
                 if name not in r["last"]:
                     raise KeyError(f"reference.errors: {name!r} is not in record.json of level {r['level']}")
-                r[name] = abs(r["last"][name])
+                ref = r["last"].get("reference_" + name.removeprefix("error_"))
+                r[name] = abs(r["last"][name]) / ref if ref else abs(r["last"][name])   # relative when possible
     if not analytic:
         q = scene.reference.quantity
         ref = rows[-1]["last"].get(q)
