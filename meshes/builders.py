@@ -67,22 +67,36 @@ class _Session:
 
 
 def _size_field(gmsh, h: float, refine: dict | None):
-    """Uniform size ``h``, or ``h`` graded down to ``refine['h']`` near a point (a ball of radius r)."""
+    """Uniform size ``h``, or ``h`` graded down to ``refine['h']`` near a point (a ball of radius r), or
+    inside a block ``refine['box'] = [lo, hi]`` (corners; a flat block is a layer), graded over ``thickness``.
+    The fine size is ``refine['h']``, or ``refine['ratio'] * h`` (then it follows h in studies and smoke runs)."""
     if not refine:
         gmsh.option.setNumber("Mesh.MeshSizeMin", h)
         gmsh.option.setNumber("Mesh.MeshSizeMax", h)
         return
     f = gmsh.model.mesh.field
-    ball = f.add("Ball")
-    c = refine["center"]
-    f.setNumber(ball, "XCenter", c[0])
-    f.setNumber(ball, "YCenter", c[1])
-    f.setNumber(ball, "ZCenter", c[2] if len(c) > 2 else 0.0)
-    f.setNumber(ball, "Radius", refine["radius"])
-    f.setNumber(ball, "Thickness", refine.get("thickness", refine["radius"]))
-    f.setNumber(ball, "VIn", refine["h"])
-    f.setNumber(ball, "VOut", h)
-    f.setAsBackgroundMesh(ball)
+    h_in = refine["h"] if "h" in refine else h * refine["ratio"]
+    if "box" in refine:
+        # a layer or block [lo, hi] (e.g. the contact face of a stamp), graded over `thickness`
+        lo, hi = refine["box"]
+        box = f.add("Box")
+        for key, v in zip(("XMin", "YMin", "ZMin", "XMax", "YMax", "ZMax"), list(lo) + [0.0] * (3 - len(lo)) + list(hi) + [0.0] * (3 - len(hi))):
+            f.setNumber(box, key, v)
+        f.setNumber(box, "Thickness", refine.get("thickness", 0.0))
+        f.setNumber(box, "VIn", h_in)
+        f.setNumber(box, "VOut", h)
+        f.setAsBackgroundMesh(box)
+    else:
+        ball = f.add("Ball")
+        c = refine["center"]
+        f.setNumber(ball, "XCenter", c[0])
+        f.setNumber(ball, "YCenter", c[1])
+        f.setNumber(ball, "ZCenter", c[2] if len(c) > 2 else 0.0)
+        f.setNumber(ball, "Radius", refine["radius"])
+        f.setNumber(ball, "Thickness", refine.get("thickness", refine["radius"]))
+        f.setNumber(ball, "VIn", h_in)
+        f.setNumber(ball, "VOut", h)
+        f.setAsBackgroundMesh(ball)
     gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
     gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
     gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
