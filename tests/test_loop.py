@@ -69,3 +69,63 @@ def test_resume_after_sigkill_reproduces_the_uninterrupted_run(tmp_path, scene_f
     hb = (cut / "history.csv").read_text().splitlines()
     assert len(ha) == len(hb)
     assert [r.split(",")[:3] for r in ha] == [r.split(",")[:3] for r in hb]
+
+
+ADAPTIVE = """
+description = "thick-walled cylinder loaded in one step with adaptive increments"
+[geometry]
+builder = "ring"
+r_inner = 1.0
+r_outer = 1.3
+h = 0.1
+[material]
+E = 70e9
+nu = 0.3
+[plasticity]
+law = "linear"
+sigma0 = 250e6
+H = 1e9
+[boundary.symmetry_x]
+ux = 0.0
+[boundary.symmetry_y]
+uy = 0.0
+[boundary.inner]
+pressure = 100e6
+[loading]
+factors = [0.5, 0.74]
+adaptive = true
+[numerics]
+newton_maxit = 5
+[output]
+png = false
+"""
+
+
+def test_adaptive_steps_cut_grow_and_land_on_the_targets(tmp_path, scene_file):
+    root = run(scene_file(ADAPTIVE), out=tmp_path / "r", progress=lambda *_: None)
+    rows = (root / "history.csv").read_text().splitlines()
+    head = rows[0].split(",")
+    lfs = [float(r.split(",")[head.index("load_factor")]) for r in rows[1:]]
+    its = [int(r.split(",")[head.index("newton_iterations")]) for r in rows[1:]]
+    assert 0.5 in lfs and lfs[-1] == 0.74                     # every target reached exactly
+    assert len(lfs) > 2 and all(b > a for a, b in zip(lfs, lfs[1:]))
+    steps = [b - a for a, b in zip([0.0] + lfs[:-1], lfs)]
+    s = json.loads((root / "summary.json").read_text())
+    assert s["step_cuts"] >= 1
+    # after an easy increment the next attempted step is larger than the one just taken
+    from wendel.run import State, grow_step
+    from wendel.scene import parse
+    import tomllib
+
+    scene = parse(tomllib.loads(ADAPTIVE))
+    st = State(accepted=[(1, 0.1)], step=0.1)
+    inc = tmp_path / "g" / "fem" / "inc-0001"
+    inc.mkdir(parents=True)
+    (inc / "record.json").write_text(json.dumps({"newton_iterations": 2}))
+    from wendel.run import RunFiles
+    grow_step(scene, st, RunFiles(tmp_path / "g"))
+    assert st.step == pytest.approx(0.15)
+    (inc / "record.json").write_text(json.dumps({"newton_iterations": 9}))
+    grow_step(scene, st, RunFiles(tmp_path / "g"))
+    assert st.step == pytest.approx(0.15)                      # a hard increment does not grow it
+    assert max(steps) <= 0.5 + 1e-12 and min(its) >= 1

@@ -66,6 +66,7 @@ class State:
     remeshes: list[dict] = field(default_factory=list)
     reequilibrate: bool = False
     quality: dict = field(default_factory=dict)
+    step: float | None = None        # adaptive loading: the current load-factor step
     launches: list[dict] = field(default_factory=list)
     mesh_seconds: float = 0.0
     post_seconds: float = 0.0
@@ -164,7 +165,10 @@ def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress)
     entry = entry_script(scene, dimension)
     while state.pending:
         inc0 = state.last[0] + 1
-        batch = state.pending[:1] if scene.remesh else list(state.pending)
+        if scene.loading.adaptive and not state.reequilibrate:
+            plan_step(scene, state)
+        one_by_one = scene.remesh is not None or scene.loading.adaptive
+        batch = state.pending[:1] if one_by_one else list(state.pending)
         loads = files.tables / "loads.txt"
         loads.write_text(f"{len(batch)}\n" + "".join(f"{lf!r}\n" for lf in batch))
         seg = state.segment(inc0)
@@ -189,6 +193,8 @@ def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress)
             cut_step(scene, files, state, failure, progress)
             _save_checkpoint(files, scene, state, dimension)
             continue
+        if scene.loading.adaptive and not state.reequilibrate:
+            grow_step(scene, state, files)
         if state.reequilibrate:
             state.reequilibrate = False
             rep = state.remeshes[-1]
@@ -199,6 +205,26 @@ def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress)
         elif scene.remesh and state.pending:
             maybe_remesh(scene, files, state, dimension, progress)
         _save_checkpoint(files, scene, state, dimension)
+
+
+def plan_step(scene: Scene, state: State) -> None:
+    """Adaptive loading: put the next load factor (last + step, never past the next target) first."""
+    loading = scene.loading
+    if state.step is None:
+        state.step = loading.nominal_step()
+    target, last = state.pending[0], state.last[1]
+    direction = 1.0 if target >= last else -1.0
+    nxt = last + direction * state.step
+    if (nxt - target) * direction < -1e-12 * max(1.0, abs(target)):
+        state.pending.insert(0, nxt)
+
+
+def grow_step(scene: Scene, state: State, files: RunFiles) -> None:
+    """Adaptive loading: after an easy increment the step grows (up to loading.max_step)."""
+    loading = scene.loading
+    rec = json.loads((files.fem / f"inc-{state.last[0]:04d}" / "record.json").read_text())
+    if rec["newton_iterations"] <= loading.easy_iterations:
+        state.step = min(state.step * loading.grow, loading.max_step or loading.nominal_step())
 
 
 def maybe_remesh(scene: Scene, files: RunFiles, state: State, dimension: int, progress) -> None:
@@ -284,15 +310,17 @@ def cut_step(scene: Scene, files: RunFiles, state: State, failure: freefem.Newto
     lf_prev, lf_fail = state.last[1], state.pending[0]
     state.cuts += 1
     mid = lf_prev + 0.5 * (lf_fail - lf_prev)
-    targets = scene.loading.load_factors()
-    nominal = min(abs(b - a) for a, b in zip([0.0] + targets[:-1], targets)) or 1.0
-    smallest = nominal / 2 ** scene.loading.max_cuts
+    smallest = scene.loading.nominal_step() / 2 ** scene.loading.max_cuts
     if reason == "limit load reached" or abs(mid - lf_prev) < smallest * (1 - 1e-9):
         what = "limit load reached" if reason == "limit load reached" else \
             f"{reason}, even after {scene.loading.max_cuts} step halvings (loading.max_cuts)"
         raise StepCutError(
             f"increment {inc} (load factor {lf_prev:g} -> {lf_fail:g}): {what}; "
             f"{len(state.accepted)} accepted increments are kept in {files.root}")
+    if scene.loading.adaptive:
+        state.step = abs(mid - lf_prev)
+        if all(abs(lf_fail - t) > 1e-12 * max(1.0, abs(t)) for t in scene.loading.load_factors()):
+            state.pending.pop(0)         # an intermediate point of the adaptive loading: plan_step re-plans
     state.pending.insert(0, mid)
     progress(f"  increment {inc}: {reason} at load factor {lf_fail:g}; cutting the step to {mid:g}")
 
@@ -363,7 +391,7 @@ def _save_checkpoint(files: RunFiles, scene: Scene, state: State, dimension: int
     data = {"scene": scene.model_dump(mode="json"), "dimension": dimension,
             "accepted": state.accepted, "pending": state.pending, "cuts": state.cuts,
             "segments": state.segments, "remeshes": state.remeshes, "reequilibrate": state.reequilibrate,
-            "quality": {str(k): v for k, v in state.quality.items()},
+            "quality": {str(k): v for k, v in state.quality.items()}, "step": state.step,
             "launches": state.launches, "mesh_seconds": state.mesh_seconds, "post_seconds": state.post_seconds}
     tmp = files.checkpoint.with_suffix(".tmp")
     tmp.write_text(json.dumps(data, indent=1))
@@ -379,7 +407,7 @@ def _resume(root: Path) -> tuple[RunFiles, Scene, State]:
     state = State(accepted=[tuple(a) for a in data["accepted"]], pending=data["pending"], cuts=data["cuts"],
                   launches=data["launches"], mesh_seconds=data["mesh_seconds"], post_seconds=data["post_seconds"],
                   segments=data["segments"], remeshes=data["remeshes"], reequilibrate=data["reequilibrate"],
-                  quality={int(k): v for k, v in data["quality"].items()})
+                  quality={int(k): v for k, v in data["quality"].items()}, step=data["step"])
     # An increment committed after the last checkpoint is taken as it is; a partial one is dropped.
     report.truncate_history(files.root, state.last[0])
     accept(scene, files, state, data["dimension"])

@@ -115,12 +115,22 @@ class Loading(Strict):
     final: float = Field(1.0, description="final load factor [1]")
     factors: Optional[list[float]] = Field(None, description="explicit load factors (replaces steps/final)")
     max_cuts: int = Field(6, ge=0, le=30, description="step halvings allowed per increment")
+    adaptive: bool = Field(False, description="grow the step after easy increments (one increment per launch); "
+                           "the load factors above are still all reached and written")
+    grow: float = Field(1.5, gt=1, le=4, description="step growth after an easy increment [1]")
+    easy_iterations: int = Field(4, ge=1, description="Newton iterations at or below which an increment is easy")
+    max_step: Optional[float] = Field(None, gt=0, description="largest load-factor step [1]; default the nominal step")
 
     def load_factors(self) -> list[float]:
         """The target load factors in order."""
         if self.factors:
             return [float(f) for f in self.factors]
         return [self.final * (i + 1) / self.steps for i in range(self.steps)]
+
+    def nominal_step(self) -> float:
+        """The smallest step between successive target load factors."""
+        t = self.load_factors()
+        return min(abs(b - a) for a, b in zip([0.0] + t[:-1], t)) or 1.0
 
 
 class Numerics(Strict):
