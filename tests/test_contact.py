@@ -211,3 +211,13 @@ def test_radial_study_writes_error_against_runtime(tmp_path):
     assert [int(r["dofs"]) for r in rows] == [17 ** 2, 33 ** 2, 65 ** 2]
     assert float(rows[-1]["rate_h1_relative"]) > 0.9
     assert (root / "error_vs_runtime.png").stat().st_size > 10000
+
+
+def test_obstacle_bench_at_three_sizes(tmp_path):
+    from wendel.bench import BENCHES, bench
+
+    root = bench(["obstacle"], quick=True, out=tmp_path / "bench", progress=lambda *_: None)
+    assert "obstacle" in BENCHES
+    rows = json.loads((root / "obstacle.json").read_text())["rows"]
+    assert [r["dofs"] for r in rows] == [17 ** 2, 33 ** 2, 65 ** 2]
+    assert all(r["active_set_iterations"] >= 1 and r["wall_time"] > 0 for r in rows)

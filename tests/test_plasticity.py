@@ -272,6 +272,15 @@ def test_cylinder_scene_records_the_plastic_radius_error(tmp_path, quiet):
     assert 0 < recs[-1]["error_plastic_radius"] < 0.3             # depth of the zone, h = 0.05 (measured 0.207)
     s = json.loads((root / "summary.json").read_text())
     assert "error_plastic_radius" in json.dumps(s)
+    # the cylinder bench's per-increment costs: differences of the cumulative record times add up
+    from wendel.bench import BENCHES
+    from wendel.benches_plasticity import increment_costs
+
+    assert "cylinder" in BENCHES
+    costs = increment_costs(root / "fem")
+    assert [c["newton_iterations"] for c in costs] == [r["newton_iterations"] for r in recs]
+    assert all(c["total"] > 0 and c["assembly"] >= 0 and c["solve"] >= 0 for c in costs)
+    assert sum(c["total"] for c in costs) == pytest.approx(recs[-1]["time_total"], rel=1e-9)   # one launch
 
 
 def test_hill_reference_needs_the_perfect_law(scene_file, tmp_path, quiet):
