@@ -267,7 +267,7 @@ def test_cylinder_scene_records_the_plastic_radius_error(tmp_path, quiet):
     assert recs[0]["error_plastic_radius"] == -1                  # 50 MPa: still elastic
     for r in recs[1:]:
         q = r["load_factor"] * 100e6
-        assert r["reference_plastic_radius"] == pytest.approx(hill_radius(q), rel=1e-9)
+        assert r["hill_plastic_radius"] == pytest.approx(hill_radius(q), rel=1e-9)
         assert abs(r["plastic_radius"] - hill_radius(q)) <= 0.04 * hill_radius(q)   # h = 0.05: up to 2.9 %
     assert 0 < recs[-1]["error_plastic_radius"] < 0.3             # depth of the zone, h = 0.05 (measured 0.207)
     s = json.loads((root / "summary.json").read_text())

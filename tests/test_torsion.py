@@ -37,8 +37,8 @@ def test_circular_bar_matches_closed_form(tmp_path, quiet):
     assert len(recs) == 6
     for r in recs:
         theta = r["twist"]
-        assert r["reference_torque"] == pytest.approx(circular_torque(theta, MU, TAU, R), rel=1e-12)
-        assert abs(r["torque"] / r["reference_torque"] - 1) < 0.015, r      # measured 0.75-0.98 %
+        assert r["closed_form_torque"] == pytest.approx(circular_torque(theta, MU, TAU, R), rel=1e-12)
+        assert abs(r["torque"] / r["closed_form_torque"] - 1) < 0.015, r      # measured 0.75-0.98 %
         if theta <= TAU / (MU * R):      # elastic: nothing yields, torque = (pi/2) mu theta R^4 (discretely linear)
             assert r["active_nodes"] == 0
         else:                            # KKT relative to max lambda: meaningful once something yields
