@@ -86,3 +86,48 @@ def test_every_workflow_validates_and_declares_a_smoke_size():
         s = load(path)
         assert s.description.strip(), path
         assert s.smoke.h is not None or s.smoke.steps is not None, f"{path}: no [smoke] size"
+
+
+BLOCK_BAD = [
+    ("hertz.toml", ('obstacle = "ball"', 'obstacle = "cube"'), "contact.obstacle",
+     "unknown obstacle 'cube'; valid: plane, ball, cylinder, heightmap"),
+    ("hertz.toml", ('boundary = "top"', 'boundary = "lid"'), "contact.boundary", "unknown boundary 'lid'"),
+    ("cylinder.toml", ('law = "perfect"', 'law = "plastic"'), "plasticity.law", "unknown"),
+    ("cylinder.toml", ("sigma0 = 250e6", "sigma0 = -250e6"), "plasticity.sigma0", "greater than 0"),
+    ("thermo-indent.toml", ('coupling = "monolithic"', 'coupling = "loose"'), "thermal.coupling",
+     "unknown coupling 'loose'"),
+    ("thermo-indent.toml", ("k = 44.5 ", "k = -44.5 "), "thermal.k", "greater than 0"),
+]
+
+
+@pytest.mark.parametrize("scene,change,key,words", BLOCK_BAD, ids=[b[2] for b in BLOCK_BAD])
+def test_bad_physics_block_is_rejected_with_file_and_key(scene_file, scene, change, key, words):
+    from conftest import WORKFLOWS
+
+    path = scene_file(edit((WORKFLOWS / scene).read_text(), *change))
+    with pytest.raises(SceneError) as exc:
+        load(path)
+    assert f"{path}: {key}" in str(exc.value)
+    assert words in str(exc.value)
+
+
+def test_values_reach_freefem_as_numbers_only(tmp_path):
+    """A scene string never reaches FreeFEM as code: every option value is a number, a validated name or a
+    path the driver wrote."""
+    from conftest import WORKFLOWS
+    from wendel.run import RunFiles, options
+    from wendel.schema import SOLVERS
+
+    for path in sorted(WORKFLOWS.glob("*.toml")):
+        scene = load(path)
+        files = RunFiles(tmp_path / path.stem)
+        opts = options(scene, files, 3 if scene.geometry.builder == "box" else 2)
+        values = opts[1::2]
+        for key, value in zip(opts[0::2], values):
+            assert key.startswith("-"), (path.name, key)
+            if value.startswith(str(tmp_path)) or value.startswith("/"):
+                continue
+            try:
+                float(value)
+            except ValueError:
+                assert value in SOLVERS, (path.name, key, value)

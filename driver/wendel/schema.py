@@ -15,7 +15,7 @@ from typing import Literal, Optional
 
 from pydantic import BaseModel, ConfigDict, Field, create_model, field_validator, model_validator
 
-from .blocks import BLOCKS, PROBLEMS, load_all
+from .blocks import BLOCKS, PROBLEMS, choice, load_all
 from .meshes import BUILDERS
 
 # Names a scene may use, mapped to the integer ids of edp/lib/loads.idp (never code).
@@ -97,15 +97,9 @@ class Boundary(Strict):
 class BodyForce(Strict):
     """A named body force (edp/lib/loads.idp)."""
 
-    kind: str = Field("none", description=f"one of {', '.join(BODY_FORCES)}")
+    kind: choice(BODY_FORCES, "body force") = Field("none", description=f"one of {', '.join(BODY_FORCES)}")
     value: list[float] = Field([0.0, 0.0, 0.0], description="vector or magnitude(s) at load factor 1 [N/m^3]")
 
-    @field_validator("kind")
-    @classmethod
-    def _kind(cls, v):
-        if v not in BODY_FORCES:
-            raise ValueError(f"unknown body force {v!r}; valid: {', '.join(BODY_FORCES)}")
-        return v
 
 
 class Loading(Strict):
@@ -137,18 +131,12 @@ class Numerics(Strict):
     """Solver settings."""
 
     ranks: int = Field(1, ge=1, le=64, description="MPI ranks")
-    solver: str = Field("direct", description=f"linear solver: {', '.join(SOLVERS)}")
+    solver: choice(SOLVERS, "solver") = Field("direct", description=f"linear solver: {', '.join(SOLVERS)}")
     solver_tol: float = Field(1e-10, gt=0, lt=1, description="relative residual of iterative solvers [1]")
     newton_tol: float = Field(1e-9, gt=0, lt=1, description="relative Newton residual [1]")
     newton_maxit: int = Field(25, ge=1, le=500, description="Newton iterations per increment")
     timeout: float = Field(3600.0, gt=0, description="wall-time limit of one FreeFEM launch [s]")
 
-    @field_validator("solver")
-    @classmethod
-    def _solver(cls, v):
-        if v not in SOLVERS:
-            raise ValueError(f"unknown solver {v!r}; valid: {', '.join(SOLVERS)}")
-        return v
 
     @model_validator(mode="after")
     def _ranks(self):
@@ -181,17 +169,12 @@ class Reference(Strict):
     """What errors are measured against: an analytic field, errors a module computes against a closed
     form (record.json keys ``error_*``), or else the finest run of a study."""
 
-    analytic: Optional[str] = Field(None, description=f"analytic field: {', '.join(ANALYTIC_REFERENCES)}")
+    analytic: Optional[choice(ANALYTIC_REFERENCES, "analytic reference")] = Field(
+        None, description=f"analytic field: {', '.join(ANALYTIC_REFERENCES)}")
     errors: list[str] = Field(default_factory=list,
                               description="record.json keys of errors against closed forms, e.g. error_hertz_p0")
     quantity: str = Field("strain_energy", description="record.json quantity compared with the finest run")
 
-    @field_validator("analytic")
-    @classmethod
-    def _analytic(cls, v):
-        if v is not None and v not in ANALYTIC_REFERENCES:
-            raise ValueError(f"unknown analytic reference {v!r}; valid: {', '.join(ANALYTIC_REFERENCES)}")
-        return v
 
     @field_validator("errors")
     @classmethod

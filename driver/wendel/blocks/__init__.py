@@ -16,7 +16,24 @@ import importlib
 import pkgutil
 from typing import Any, Callable
 
-from pydantic import BaseModel
+from pydantic import AfterValidator, BaseModel
+from typing_extensions import Annotated
+
+
+def choice(registry, what: str):
+    """A string type whose value must be a key of ``registry``; the error lists the valid names.
+
+    >>> from pydantic import TypeAdapter
+    >>> TypeAdapter(choice({"ball": 1}, "obstacle")).validate_python("ball")
+    'ball'
+    """
+
+    def check(v: str) -> str:
+        if v not in registry:
+            raise ValueError(f"unknown {what} {v!r}; valid: {', '.join(registry)}")
+        return v
+
+    return Annotated[str, AfterValidator(check)]
 
 
 @dataclasses.dataclass(frozen=True)

@@ -28,7 +28,7 @@ from pydantic import BaseModel, ConfigDict, Field, field_validator, model_valida
 import json
 import shutil
 
-from . import Block, Problem, register, register_problem
+from . import Block, Problem, choice, register, register_problem
 from ..meshes import LABELS
 
 OBSTACLES = {"plane": 1, "ball": 2, "cylinder": 3, "heightmap": 4}
@@ -44,9 +44,9 @@ class Contact(BaseModel):
 
     model_config = ConfigDict(extra="forbid", validate_assignment=True)
 
-    boundary: str = Field(..., description="named contact boundary (meshes/labels.py)")
+    boundary: choice(LABELS, "boundary") = Field(..., description="named contact boundary (meshes/labels.py)")
     normal: str = Field("+y", description="outward normal of that boundary: +x, -x, +y, -y, +z or -z")
-    obstacle: str = Field("plane", description=f"obstacle shape: {', '.join(OBSTACLES)}")
+    obstacle: choice(OBSTACLES, "obstacle") = Field("plane", description=f"obstacle shape: {', '.join(OBSTACLES)}")
     center: list[float] = Field([0.0, 0.0, 0.0], description="plane point, ball/cylinder centre, heightmap base and centre [m]")
     radius: float = Field(1.0, gt=0, description="ball or cylinder radius [m]")
     cylinder_axis: str = Field("x", description="3D cylinder axis direction: x, y or z (not the normal's)")
@@ -55,14 +55,8 @@ class Contact(BaseModel):
     height: float = Field(0.0, ge=0, description="heightmap: protrusion of white over black towards the body [m]")
     size: list[float] = Field([1.0, 1.0], description="heightmap: footprint along the two tangential axes [m]")
     c: float = Field(0.0, ge=0, description="active-set constant [Pa/m]; 0 = E / h_min (the solution does not depend on it)")
-    reference: Optional[str] = Field(None, description=f"reference solution: {', '.join(REFERENCES)} (contact size and peak pressure)")
+    reference: Optional[choice(REFERENCES, "contact reference")] = Field(None, description=f"reference solution: {', '.join(REFERENCES)} (contact size and peak pressure)")
 
-    @field_validator("boundary")
-    @classmethod
-    def _boundary(cls, v):
-        if v not in LABELS:
-            raise ValueError(f"unknown boundary {v!r}; valid: {', '.join(LABELS)}")
-        return v
 
     @field_validator("normal")
     @classmethod
@@ -71,19 +65,7 @@ class Contact(BaseModel):
             raise ValueError(f"normal must be one of +x, -x, +y, -y, +z, -z; got {v!r}")
         return v
 
-    @field_validator("obstacle")
-    @classmethod
-    def _obstacle(cls, v):
-        if v not in OBSTACLES:
-            raise ValueError(f"unknown obstacle {v!r}; valid: {', '.join(OBSTACLES)}")
-        return v
 
-    @field_validator("reference")
-    @classmethod
-    def _reference(cls, v):
-        if v is not None and v not in REFERENCES:
-            raise ValueError(f"unknown contact reference {v!r}; valid: {', '.join(REFERENCES)}")
-        return v
 
     @model_validator(mode="after")
     def _consistency(self):
@@ -135,17 +117,11 @@ class MembraneObstacle(BaseModel):
 
     model_config = ConfigDict(extra="forbid", validate_assignment=True)
 
-    shape: str = Field("staircase", description="obstacle and data: staircase (step-41, u = 0 on the boundary), "
+    shape: choice(MEMBRANE_SHAPES, "membrane obstacle") = Field("staircase", description="obstacle and data: staircase (step-41, u = 0 on the boundary), "
                        "radial (g = sqrt(1 - r^2), exact solution as boundary data and reference)")
     f: Optional[float] = Field(None, description="load density [1/m]; default -10 (staircase), 0 (radial)")
     c: float = Field(100.0, gt=0, description="active-set constant [1/m^2]; the solution does not depend on it")
 
-    @field_validator("shape")
-    @classmethod
-    def _shape(cls, v):
-        if v not in MEMBRANE_SHAPES:
-            raise ValueError(f"unknown membrane obstacle {v!r}; valid: {', '.join(MEMBRANE_SHAPES)}")
-        return v
 
 
 def _membrane_entry(scene, dimension: int) -> str:

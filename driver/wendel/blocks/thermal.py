@@ -19,7 +19,7 @@ from typing import Literal, Optional, Union
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
-from . import Block, register
+from . import Block, choice, register
 from ..meshes import LABELS
 
 COUPLINGS = {"monolithic": 0, "staggered": 1, "adiabatic": 2}
@@ -70,18 +70,12 @@ class Thermal(BaseModel):
     boundary: dict[str, ThermalBoundary] = Field(default_factory=dict, description="thermal conditions by boundary name (unnamed boundaries are insulated)")
     source: Union[float, Literal["manufactured"]] = Field(0.0, description="volumetric heat source [W/m^3], or \"manufactured\" (with reference.analytic = \"manufactured-sine\")")
     beta: float = Field(0.9, ge=0, le=1, description="Taylor-Quinney fraction of plastic work turned into heat [1]")
-    coupling: str = Field("monolithic", description=f"solution of the coupled problem: {', '.join(COUPLINGS)}")
+    coupling: choice(COUPLINGS, "coupling") = Field("monolithic", description=f"solution of the coupled problem: {', '.join(COUPLINGS)}")
     duration: float = Field(0.0, ge=0, description="process time at load factor 1: an increment lasts (lf - lf_old) * duration [s]; 0 = steady heat equation")
     mms_amplitude: float = Field(1.0, description="amplitude of the manufactured temperature T_ref + lf A phi [K]")
     tool_temperature: Optional[float] = Field(None, gt=0, description="temperature of the contact tool [K]; default T_ref")
     contact_conductance: float = Field(0.0, ge=0, description="heat transfer coefficient through the active contact zone [W/m^2/K]")
 
-    @field_validator("coupling")
-    @classmethod
-    def _coupling(cls, v):
-        if v not in COUPLINGS:
-            raise ValueError(f"unknown coupling {v!r}; valid: {', '.join(COUPLINGS)}")
-        return v
 
     @field_validator("boundary")
     @classmethod
