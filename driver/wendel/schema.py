@@ -269,11 +269,14 @@ def _describe(model: type[BaseModel], prefix: str) -> list[tuple[str, str, str, 
             continue
         rng = ", ".join(f"{type(m).__name__.lower()} {getattr(m, type(m).__name__.lower(), '')}"
                         for m in f.metadata if type(m).__name__ in ("Gt", "Ge", "Lt", "Le"))
-        inner = [a for a in args if a is not type(None)]
+        inner = [typing.get_args(a)[0] if typing.get_origin(a) is typing.Annotated else a
+                 for a in args if a is not type(None)]
         if getattr(ann, "__name__", "") == "Literal" or str(ann).startswith("typing.Literal"):
             typ = " \\| ".join(repr(a) for a in args)
         elif type(None) in args and inner:
             typ = getattr(inner[0], "__name__", str(inner[0])) + ", optional"
+        elif typing.get_origin(ann) is typing.Union:
+            typ = " or ".join(getattr(a, "__name__", str(a)) for a in inner)
         else:
             typ = getattr(ann, "__name__", str(ann))
         default = "required" if f.is_required() else repr(f.default) if f.default_factory is None else "{}"
