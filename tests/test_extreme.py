@@ -3,8 +3,6 @@
 import json
 
 import numpy as np
-import pytest
-
 from wendel.run import StepCutError, run
 
 from conftest import SMOKE_SCENE, WORKFLOWS

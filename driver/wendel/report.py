@@ -99,7 +99,6 @@ def read_records(root: Path) -> list[dict]:
 def write_summary(root: Path, scene, state, dimension: int) -> dict:
     """summary.json: fingerprints of the last increment and wall time by phase."""
     records = read_records(root)
-    launch_wall = sum(l["wall"] for l in state.launches)
     phases = {"mesh": state.mesh_seconds, "freefem_startup": 0.0, "assembly": 0.0, "linear_solve": 0.0,
               "constitutive": 0.0, "freefem_output": 0.0, "freefem_other": 0.0,
               "driver_output": state.post_seconds}

@@ -5,7 +5,6 @@
 
 from __future__ import annotations
 
-import csv
 import json
 import os
 import shutil
@@ -81,11 +80,10 @@ class State:
 
 
 def run(scene_path: str | Path, smoke: bool = False, ranks: int | None = None, out: Path | None = None,
-        resume: Path | None = None, progress=print, h: float | None = None, png: bool | None = None,
-        scale: float | None = None) -> Path:
+        resume: Path | None = None, progress=print, png: bool | None = None, scale: float | None = None) -> Path:
     """Run the scene file ``scene_path``; return the run folder (results/<scene>/<run-id>/).
 
-    ``ranks``, ``h`` and ``png`` override numerics.ranks, geometry.h and output.png; ``scale`` multiplies
+    ``ranks`` and ``png`` override numerics.ranks and output.png; ``scale`` multiplies
     geometry.h and the size of a refined zone (geometry.refine.h); ``resume`` continues the run folder
     given from its last checkpoint.
     """
@@ -95,8 +93,6 @@ def run(scene_path: str | Path, smoke: bool = False, ranks: int | None = None, o
         return _execute(scene, files, state, progress)
     scene_path = Path(scene_path)
     scene = load(scene_path, smoke=smoke)
-    if h is not None:
-        scene.geometry.h = h
     if scale is not None:
         scene.geometry.h *= scale
         refine = (scene.geometry.model_extra or {}).get("refine")

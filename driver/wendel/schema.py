@@ -23,6 +23,10 @@ BODY_FORCES = {"none": 0, "constant": 1, "step8-discs": 2, "manufactured": 3}
 ANALYTIC_REFERENCES = {"manufactured-sine": 1}
 SOLVERS = ("direct", "cg", "ffddm")
 
+BodyForceName = choice(BODY_FORCES, "body force")
+SolverName = choice(SOLVERS, "solver")
+AnalyticName = choice(ANALYTIC_REFERENCES, "analytic reference")
+
 
 class Strict(BaseModel):
     """Base of every scene table: unknown keys are errors."""
@@ -97,7 +101,7 @@ class Boundary(Strict):
 class BodyForce(Strict):
     """A named body force (edp/lib/loads.idp)."""
 
-    kind: choice(BODY_FORCES, "body force") = Field("none", description=f"one of {', '.join(BODY_FORCES)}")
+    kind: BodyForceName = Field("none", description=f"one of {', '.join(BODY_FORCES)}")
     value: list[float] = Field([0.0, 0.0, 0.0], description="vector or magnitude(s) at load factor 1 [N/m^3]")
 
 
@@ -131,7 +135,7 @@ class Numerics(Strict):
     """Solver settings."""
 
     ranks: int = Field(1, ge=1, le=64, description="MPI ranks")
-    solver: choice(SOLVERS, "solver") = Field("direct", description=f"linear solver: {', '.join(SOLVERS)}")
+    solver: SolverName = Field("direct", description=f"linear solver: {', '.join(SOLVERS)}")
     solver_tol: float = Field(1e-10, gt=0, lt=1, description="relative residual of iterative solvers [1]")
     newton_tol: float = Field(1e-9, gt=0, lt=1, description="relative Newton residual [1]")
     newton_maxit: int = Field(25, ge=1, le=500, description="Newton iterations per increment")
@@ -169,7 +173,7 @@ class Reference(Strict):
     """What errors are measured against: an analytic field, errors a module computes against a closed
     form (record.json keys ``error_*``), or else the finest run of a study."""
 
-    analytic: Optional[choice(ANALYTIC_REFERENCES, "analytic reference")] = Field(
+    analytic: Optional[AnalyticName] = Field(
         None, description=f"analytic field: {', '.join(ANALYTIC_REFERENCES)}")
     errors: list[str] = Field(default_factory=list,
                               description="record.json keys of errors against closed forms, e.g. error_hertz_p0")

@@ -36,6 +36,10 @@ OBSTACLES = {"plane": 1, "ball": 2, "cylinder": 3, "heightmap": 4}
 REFERENCES = {"hertz": 1}
 """Reference name -> ``-contact_ref`` id of contact.idp."""
 AXES = {"x": 0, "y": 1, "z": 2}
+
+BoundaryName = choice(LABELS, "boundary")
+ObstacleName = choice(OBSTACLES, "obstacle")
+ContactReferenceName = choice(REFERENCES, "contact reference")
 ROOT = Path(__file__).resolve().parents[3]
 
 
@@ -44,9 +48,9 @@ class Contact(BaseModel):
 
     model_config = ConfigDict(extra="forbid", validate_assignment=True)
 
-    boundary: choice(LABELS, "boundary") = Field(..., description="named contact boundary (meshes/labels.py)")
+    boundary: BoundaryName = Field(..., description="named contact boundary (meshes/labels.py)")
     normal: str = Field("+y", description="outward normal of that boundary: +x, -x, +y, -y, +z or -z")
-    obstacle: choice(OBSTACLES, "obstacle") = Field("plane", description=f"obstacle shape: {', '.join(OBSTACLES)}")
+    obstacle: ObstacleName = Field("plane", description=f"obstacle shape: {', '.join(OBSTACLES)}")
     center: list[float] = Field([0.0, 0.0, 0.0], description="plane point, ball/cylinder centre, heightmap base and centre [m]")
     radius: float = Field(1.0, gt=0, description="ball or cylinder radius [m]")
     cylinder_axis: str = Field("x", description="3D cylinder axis direction: x, y or z (not the normal's)")
@@ -55,7 +59,7 @@ class Contact(BaseModel):
     height: float = Field(0.0, ge=0, description="heightmap: protrusion of white over black towards the body [m]")
     size: list[float] = Field([1.0, 1.0], description="heightmap: footprint along the two tangential axes [m]")
     c: float = Field(0.0, ge=0, description="active-set constant [Pa/m]; 0 = E / h_min (the solution does not depend on it)")
-    reference: Optional[choice(REFERENCES, "contact reference")] = Field(None, description=f"reference solution: {', '.join(REFERENCES)} (contact size and peak pressure)")
+    reference: Optional[ContactReferenceName] = Field(None, description=f"reference solution: {', '.join(REFERENCES)} (contact size and peak pressure)")
 
 
     @field_validator("normal")
@@ -109,6 +113,7 @@ register(Block(name="contact", model=Contact, options=options,
 
 
 MEMBRANE_SHAPES = {"staircase": 1, "radial": 2}
+MembraneShapeName = choice(MEMBRANE_SHAPES, "membrane obstacle")
 """Membrane obstacle name -> ``-obst_id`` of obstacle.edp."""
 
 
@@ -117,7 +122,7 @@ class MembraneObstacle(BaseModel):
 
     model_config = ConfigDict(extra="forbid", validate_assignment=True)
 
-    shape: choice(MEMBRANE_SHAPES, "membrane obstacle") = Field("staircase", description="obstacle and data: staircase (step-41, u = 0 on the boundary), "
+    shape: MembraneShapeName = Field("staircase", description="obstacle and data: staircase (step-41, u = 0 on the boundary), "
                        "radial (g = sqrt(1 - r^2), exact solution as boundary data and reference)")
     f: Optional[float] = Field(None, description="load density [1/m]; default -10 (staircase), 0 (radial)")
     c: float = Field(100.0, gt=0, description="active-set constant [1/m^2]; the solution does not depend on it")

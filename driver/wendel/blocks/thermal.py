@@ -23,6 +23,7 @@ from . import Block, choice, register
 from ..meshes import LABELS
 
 COUPLINGS = {"monolithic": 0, "staggered": 1, "adiabatic": 2}
+CouplingName = choice(COUPLINGS, "coupling")
 """Coupling name -> ``-therm_coupling`` id of thermal.idp."""
 SOURCES = {"none": 0, "uniform": 1, "manufactured": 2}
 """Heat source kind -> ``-therm_source_id`` id of thermal.idp."""
@@ -70,7 +71,7 @@ class Thermal(BaseModel):
     boundary: dict[str, ThermalBoundary] = Field(default_factory=dict, description="thermal conditions by boundary name (unnamed boundaries are insulated)")
     source: Union[float, Literal["manufactured"]] = Field(0.0, description="volumetric heat source [W/m^3], or \"manufactured\" (with reference.analytic = \"manufactured-sine\")")
     beta: float = Field(0.9, ge=0, le=1, description="Taylor-Quinney fraction of plastic work turned into heat [1]")
-    coupling: choice(COUPLINGS, "coupling") = Field("monolithic", description=f"solution of the coupled problem: {', '.join(COUPLINGS)}")
+    coupling: CouplingName = Field("monolithic", description=f"solution of the coupled problem: {', '.join(COUPLINGS)}")
     duration: float = Field(0.0, ge=0, description="process time at load factor 1: an increment lasts (lf - lf_old) * duration [s]; 0 = steady heat equation")
     mms_amplitude: float = Field(1.0, description="amplitude of the manufactured temperature T_ref + lf A phi [K]")
     tool_temperature: Optional[float] = Field(None, gt=0, description="temperature of the contact tool [K]; default T_ref")
