@@ -30,6 +30,7 @@ def test_forced_remesh_at_a_known_increment_and_pvd_through_remeshes(tmp_path, s
     assert rep["residual_after_reequilibration"] < 1e-7 < rep["residual_after_transfer"]
     assert rep["new_elements"] != rep["old_elements"]
     assert abs(rep["integral_p_after"] - rep["integral_p_before"]) <= 0.05 * rep["integral_p_before"]
+    assert 0 <= rep["yield_violation_after_transfer"] <= 1
     hist = (root / "history.csv").read_text().splitlines()
     header = hist[0].split(",")
     reeq = [r.split(",")[header.index("reequilibration")] for r in hist[1:]]

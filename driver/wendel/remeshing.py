@@ -48,8 +48,33 @@ def cell_volumes(points: np.ndarray, cells: np.ndarray) -> np.ndarray:
     return np.abs(quality.signed_measure(points, cells))
 
 
+def yield_violation(eps0: np.ndarray, epsp: np.ndarray, sigma_y: np.ndarray, mu: float, dimension: int) -> float:
+    """Fraction of cells whose von Mises stress exceeds the yield stress after a transfer.
+
+    ``eps0``: total strain per cell (Mandel; 2D [xx, yy, sqrt2 xy]); ``epsp``: plastic strain per cell
+    (Mandel; 2D [xx, yy, zz, sqrt2 xy], 3D as eps0). The pressure does not enter von Mises stress, so only
+    the shear modulus ``mu`` is needed: s = 2 mu dev(eps - epsp).
+
+    >>> e = np.array([[1e-3, -1e-3, 0.0]]); z = np.zeros((1, 4))
+    >>> yield_violation(e, z, np.array([100e6]), 80e9, 2), yield_violation(e, z, np.array([300e6]), 80e9, 2)
+    (1.0, 0.0)
+    """
+    if dimension == 2:
+        tot = np.column_stack([eps0[:, 0], eps0[:, 1], np.zeros(len(eps0)), eps0[:, 2]])
+        ee = tot - epsp
+        normal, shear = ee[:, :3], ee[:, 3:]
+    else:
+        ee = eps0 - epsp
+        normal, shear = ee[:, :3], ee[:, 3:]
+    dev = normal - normal.mean(axis=1, keepdims=True)
+    dev_norm = np.sqrt((dev ** 2).sum(axis=1) + (shear ** 2).sum(axis=1))
+    vm = np.sqrt(1.5) * 2 * mu * dev_norm
+    return float(np.mean(vm > sigma_y * (1 + 1e-6)))
+
+
 def remesh_state(inc_dir: Path, mesh_old: Path, ubase_old: np.ndarray | None, dimension: int,
-                 mesh_new: Path, state_new: Path, h: float, h_min: float, indicator: str) -> dict:
+                 mesh_new: Path, state_new: Path, h: float, h_min: float, indicator: str,
+                 mu: float | None = None) -> dict:
     """Mesh the deformed body of increment ``inc_dir`` anew and write the transferred state.
 
     Writes ``mesh_new`` and, in ``state_new``, ``u.node.txt`` (zeros), ``ubase.txt``, ``eps0.txt`` and the
@@ -112,6 +137,24 @@ def remesh_state(inc_dir: Path, mesh_old: Path, ubase_old: np.ndarray | None, di
             report["integral_p_after"] = float(vol_new @ per_cell[:, 0])
             report["max_p_before"] = float(old.max())
             report["max_p_after"] = float(per_cell[:, 0].max())
+    written = {name: output.read_array(state_new / name) for _, name, _ in fields if name.endswith(".qp.txt")}
+    if mu and "plast_epsp.qp.txt" in written and "plast_sigma_y.qp.txt" in written:
+        m = len(new_cells)
+        eps0 = output.read_array(state_new / "eps0.txt").reshape(m, -1)
+        epsp = written["plast_epsp.qp.txt"].reshape(-1, m).T
+        report["yield_violation_after_transfer"] = yield_violation(eps0, epsp, written["plast_sigma_y.qp.txt"], mu,
+                                                                   dimension)
+    for name in ("T.node.txt",):
+        if (state_new / name).is_file():
+            t_old = output.read_array(inc_dir / name)
+            t_new = output.read_array(state_new / name)
+            report["integral_T_before"] = float(vol_old @ transfer.nodes_to_cells(cells, t_old))
+            report["integral_T_after"] = float(vol_new @ transfer.nodes_to_cells(new_cells, t_new))
+            report["max_T_before"], report["max_T_after"] = float(t_old.max()), float(t_new.max())
+    rec = json.loads((inc_dir / "record.json").read_text())
+    for key in ("contact_force", "contact_active_nodes", "max_plastic_strain"):
+        if key in rec:
+            report[f"{key}_before"] = rec[key]
     for f in sorted(inc_dir.glob("*.txt")):
         if not f.name.endswith((".node.txt", ".cell.txt", ".qp.txt")) and not (state_new / f.name).exists():
             shutil.copyfile(f, state_new / f.name)
@@ -148,7 +191,7 @@ def finish_report(report: dict, reeq_dir: Path, path: Path) -> dict:
     report["residual_after_reequilibration"] = float(rows[-1][col])
     report["reequilibration_iterations"] = len(rows) - 1
     rec = json.loads((reeq_dir / "record.json").read_text())
-    for key in ("contact_force", "max_plastic_strain", "plastic_points"):
+    for key in ("contact_force", "contact_active_nodes", "max_plastic_strain", "plastic_points"):
         if key in rec:
             report[f"{key}_after"] = rec[key]
     path.parent.mkdir(exist_ok=True)

@@ -247,7 +247,8 @@ def maybe_remesh(scene: Scene, files: RunFiles, state: State, dimension: int, pr
     progress(f"  increment {inc}: min quality {q.get('min_quality', float('nan')):.3g}"
              f"{' (asked by remesh.at)' if not poor else ''}: remeshing")
     rep = remeshing.remesh_state(files.fem / f"inc-{inc:04d}", files.root / seg["mesh"], ubase_old, dimension,
-                                 files.root / mesh_new, files.root / state_dir, h, r.h_min or h / 3, r.indicator)
+                                 files.root / mesh_new, files.root / state_dir, h, r.h_min or h / 3, r.indicator,
+                                 mu=scene.material.E / (2 * (1 + scene.material.nu)))
     rep.update({"remesh": k, "after_increment": inc, "load_factor": lf})
     state.remeshes.append(rep)
     state.segments.append({"first": inc + 1, "mesh": mesh_new, "ubase": f"{state_dir}/ubase.txt",
