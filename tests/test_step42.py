@@ -47,7 +47,8 @@ def test_step42_convention_is_linear_hardening_in_von_mises_form():
 
 
 def test_ball_indent_reports_step42_fingerprints_and_fields(tmp_path):
-    root = run(WORKFLOWS / "ball-indent.toml", smoke=True, out=tmp_path / "ball", progress=lambda *_: None, h=0.25)
+    root = run(WORKFLOWS / "ball-indent.toml", smoke=True, out=tmp_path / "ball", progress=lambda *_: None,
+               scale=0.25 / 0.4)      # smoke h = 0.4 -> 0.25 (contact zone h/8)
     s = summary(root)
     last = s["last_increment"]
     assert s["completed"]

@@ -152,13 +152,15 @@ register_problem(Problem(name="membrane-obstacle", entry=_membrane_entry, option
 def bench_obstacle(quick: bool, workdir) -> list[dict]:
     """step-41 at 3 mesh sizes: active-set iterations, DoFs, wall time (register as ``wendel bench obstacle``)."""
     from ..run import run
+    from ..scene import load
 
     scene = ROOT / "workflows" / "obstacle.toml"
+    h0 = load(scene).geometry.h
     rows = []
     for n in ((16, 32, 64) if quick else (32, 64, 128)):
         out = workdir / f"n{n}"
         shutil.rmtree(out, ignore_errors=True)
-        root = run(scene, out=out, h=2.0 / n, png=False, progress=lambda *_: None)
+        root = run(scene, out=out, scale=2.0 / n / h0, png=False, progress=lambda *_: None)
         s = json.loads((root / "summary.json").read_text())
         last = s["last_increment"]
         rows.append({"cells_per_side": n, "dofs": s["dofs"], "active_set_iterations": last["active_set_iterations"],
