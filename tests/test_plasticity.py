@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from wendel import freefem
+from wendel import freefem, output
 from wendel.run import StepCutError, run
 
 from conftest import ROOT, WORKFLOWS
@@ -88,7 +88,7 @@ def records(out: Path) -> list[dict]:
 
 
 def cell(out: Path, inc: int, name: str) -> np.ndarray:
-    return np.loadtxt(out / f"inc-{inc:04d}" / f"{name}.cell.txt")[1:]
+    return output.read_array(out / f"inc-{inc:04d}" / f"{name}.cell.txt")
 
 
 # ---- uniaxial stress: unit cube, x, y, z symmetry planes, top pulled by DELTA * load factor

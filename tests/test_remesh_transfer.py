@@ -297,7 +297,9 @@ def _freefem(entry, mesh, tmp_path, bc_rows):
     run = subprocess.run(["bash", "-c", cmd], capture_output=True, text=True, timeout=120, cwd=ROOT)
     inc = tmp_path / "out" / "inc-0001"
     assert (inc / "done").exists(), run.stdout[-2000:] + run.stderr[-2000:]
-    u = np.loadtxt(inc / "u.node.txt")[1:]  # count, then interleaved [ux0, uy0, ...]
+    from wendel.output import read_array
+
+    u = read_array(inc / "u.node.txt")  # interleaved [ux0, uy0, ...]
     return u
 
 

@@ -43,8 +43,7 @@ def test_free_expansion(tmp_path):
     scale = E * ALPHA * DT
     assert max(abs(last["mean_stress_min"]), abs(last["mean_stress_max"]), last["max_von_mises"]) <= 1e-6 * scale
     u = output.read_array(root / "fem" / "inc-0001" / "u.node.txt").reshape(-1, 3)
-    with open(root / "fem" / "vertices.txt") as f:
-        xyz = np.loadtxt(f, skiprows=1)
+    xyz = output.read_vertices(root / "fem" / "vertices.txt")
     assert np.abs(u - ALPHA * DT * xyz).max() <= 1e-6 * ALPHA * DT * np.abs(xyz).max()   # strain alpha dT
     assert last["newton_iterations"] <= 2                # staggered: heat, then mechanics
 

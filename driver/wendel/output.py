@@ -18,8 +18,11 @@ CELL_TYPES = {2: "triangle", 3: "tetra"}
 
 
 def read_array(path: Path) -> np.ndarray:
-    """Read edp's plain array format: the count, then one value per line."""
-    data = np.loadtxt(path, ndmin=1)
+    """Read edp's plain array format: the count, then the values (any whitespace)."""
+    with open(path) as f:
+        data = np.array(f.read().split(), dtype=float)
+    if data.size == 0:
+        raise ValueError(f"{path}: empty array file")
     n = int(data[0])
     if data.size - 1 != n:
         raise ValueError(f"{path}: header says {n} values, found {data.size - 1}")
@@ -42,11 +45,15 @@ def read_mesh(path: Path, dimension: int) -> tuple[np.ndarray, np.ndarray]:
     return m.points, cells
 
 
+def read_vertices(vertices_txt: Path) -> np.ndarray:
+    """FreeFEM's vertex coordinates (n, 3) from ``vertices.txt`` (component-major: all x, all y, all z)."""
+    return read_array(vertices_txt).reshape(3, -1).T
+
+
 def check_node_order(vertices_txt: Path, points: np.ndarray) -> None:
     """Fail loudly if FreeFEM's vertex order differs from the mesh file's node order."""
-    with open(vertices_txt) as f:
-        n = int(f.readline())
-        xyz = np.loadtxt(f, ndmin=2)
+    xyz = read_vertices(vertices_txt)
+    n = len(xyz)
     if n != len(points) or not np.allclose(xyz, points[:, :3], rtol=0, atol=1e-9 * max(1.0, np.abs(points).max())):
         raise RuntimeError(f"{vertices_txt}: FreeFEM's vertices do not match the nodes of the mesh file "
                            f"({n} vs {len(points)}); the VTU would be wrong")

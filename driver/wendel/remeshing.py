@@ -7,8 +7,8 @@ it is too poor (or the scene asks for a remesh at that increment), gmsh meshes t
 
 - displacement: the total displacement reached (``u_total = ubase + u``) becomes the new ``ubase``
   (Dirichlet values are measured from the original body); ``u`` restarts at zero;
-- total strain (``strain.cell.txt``) becomes the pre-strain ``eps0`` of the new mesh, so the stress
-  state is kept;
+- total strain (the ``strain_*`` cell fields) becomes the pre-strain ``eps0`` of the new mesh (Mandel,
+  component-major), so the stress state is kept;
 - module state: nodal files (``*.node.txt``, e.g. temperature) are interpolated; quadrature-point
   files (``*.qp.txt``, component-major, one point per element with P1) are recovered to nodes by a
   volume-weighted average (which keeps their integral), interpolated and averaged on the new cells;
@@ -105,7 +105,7 @@ def remesh_state(inc_dir: Path, mesh_old: Path, ubase_old: np.ndarray | None, di
     # to nodes (volume-weighted, integral kept), all stacked, interpolated once, split again.
     utot = u + (ubase_old if ubase_old is not None else 0.0)
     fields = [("node", "ubase.txt", utot.reshape(n_old, dimension)),
-              ("cell", "eps0.txt", transfer.cell_to_nodes(xd, cells, cellfield("strain")))]
+              ("cell", "eps0.txt", transfer.cell_to_nodes(xd, cells, mandel_strain(inc_dir, dimension)))]
     for f in sorted(inc_dir.glob("*.node.txt")):
         if f.name.removesuffix(".node.txt") not in SKIP_NODE:
             fields.append(("node", f.name, output.read_array(f).reshape(n_old, -1)))
@@ -130,7 +130,7 @@ def remesh_state(inc_dir: Path, mesh_old: Path, ubase_old: np.ndarray | None, di
             output.write_array(state_new / name, part)            # interleaved per node
             continue
         per_cell = transfer.nodes_to_cells(new_cells, part)
-        output.write_array(state_new / name, per_cell if kind == "cell" else per_cell.T)
+        output.write_array(state_new / name, per_cell.T)          # component-major for FreeFEM
         if kind == "qp" and (name.endswith("_p.qp.txt") or name == "p.qp.txt"):
             old = qp_cells[name][:, 0]
             report["integral_p_before"] = float(vol_old @ old)
@@ -140,7 +140,7 @@ def remesh_state(inc_dir: Path, mesh_old: Path, ubase_old: np.ndarray | None, di
     written = {name: output.read_array(state_new / name) for _, name, _ in fields if name.endswith(".qp.txt")}
     if mu and "plast_epsp.qp.txt" in written and "plast_sigma_y.qp.txt" in written:
         m = len(new_cells)
-        eps0 = output.read_array(state_new / "eps0.txt").reshape(m, -1)
+        eps0 = output.read_array(state_new / "eps0.txt").reshape(-1, m).T
         epsp = written["plast_epsp.qp.txt"].reshape(-1, m).T
         report["yield_violation_after_transfer"] = yield_violation(eps0, epsp, written["plast_sigma_y.qp.txt"], mu,
                                                                    dimension)
@@ -175,6 +175,16 @@ def _quiet_stdout():
         sys.stdout.flush()
         os.dup2(saved, 1)
         os.close(saved)
+
+
+STRAIN = {2: ("xx", "yy", "xy"), 3: ("xx", "yy", "zz", "yz", "xz", "xy")}
+
+
+def mandel_strain(inc_dir: Path, dimension: int) -> np.ndarray:
+    """The total strain of an increment as Mandel vectors per cell (shear components x sqrt2)."""
+    comps = STRAIN[dimension]
+    cols = [output.read_array(inc_dir / f"strain_{c}.cell.txt") for c in comps]
+    return np.column_stack([v * (np.sqrt(2.0) if c[0] != c[1] else 1.0) for c, v in zip(comps, cols)])
 
 
 def _cells(path: Path, n_cells: int) -> np.ndarray:
