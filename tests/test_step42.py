@@ -75,7 +75,7 @@ def test_stamp_indent_touches_only_the_raised_pixels(tmp_path):
     assert s["completed"] and last["contact_active_nodes"] > 0 and last["contact_force"] > 0
     assert last["newton_iterations"] <= 10           # step-42: 5 at 14,739 DoFs
     active = output.read_array(root / "fem" / "inc-0001" / "contact_active.node.txt")
-    pts = np.loadtxt(root / "fem" / "vertices.txt", skiprows=1)
+    pts = output.read_vertices(root / "fem" / "vertices.txt")
     tokens = [t for line in (WORKFLOWS / "images" / "stamp-character.pgm").read_text().splitlines()
               if not line.startswith("#") for t in line.split()]
     nx, ny = int(tokens[1]), int(tokens[2])
