@@ -12,7 +12,7 @@ past the elastic limit theta_e = tau_y / (mu R), T = (pi / 2) mu theta R^4 below
 >>> Torsion(mu=80e9, tau_y=200e6, theta=1.0).reference is None
 True
 >>> round(circular_torque(1.0, mu=80e9, tau_y=200e6, radius=0.01), 6)   # N m, c/R = 1/4
-417.824266
+417.242774
 """
 
 from __future__ import annotations
