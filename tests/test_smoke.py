@@ -70,6 +70,7 @@ def test_summary_states_phases_and_shares(smoke_runs):
     assert s["completed"] and s["increments"] == 1 and s["dofs"] > 0
     prov = json.loads((one / "provenance.json").read_text())
     assert prov["versions"]["freefem++"].startswith("4.") and "gmsh" in prov["versions"]
+    assert prov["start"] <= prov["end"] and prov["git_commit"]
     assert (one / "scene.toml").is_file() and (one / "freefem.log").is_file()
 
 

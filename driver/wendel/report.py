@@ -145,6 +145,11 @@ def write_summary(root: Path, scene, state, dimension: int) -> dict:
         "errors": {k: v for k, v in last.items() if k.startswith("error_") and isinstance(v, (int, float)) and v >= 0},
         "last_increment": last,
     }
+    prov_path = root / "provenance.json"
+    if prov_path.is_file():
+        prov = json.loads(prov_path.read_text())
+        prov["end"] = time.strftime("%Y-%m-%dT%H:%M:%S%z")
+        prov_path.write_text(json.dumps(prov, indent=1))
     tmp = root / "summary.json.tmp"
     tmp.write_text(json.dumps(summary, indent=1))
     os.replace(tmp, root / "summary.json")
