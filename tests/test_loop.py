@@ -130,3 +130,15 @@ def test_adaptive_steps_cut_grow_and_land_on_the_targets(tmp_path, scene_file):
     grow_step(scene, st, RunFiles(tmp_path / "g"))
     assert st.step == pytest.approx(0.15)                      # a hard increment does not grow it
     assert max(steps) <= 0.5 + 1e-12 and min(its) >= 1
+
+
+def test_progress_heartbeat_reports_the_running_newton_iteration(tmp_path):
+    from wendel.run import _Progress
+
+    inc = tmp_path / "inc-0003"
+    inc.mkdir()
+    (inc / "newton.csv").write_text("increment,load_factor,iteration,residual,relative_residual\n"
+                                    "3,0.5,0,1.0,1.0\n3,0.5,1,0.01,0.0123\n")
+    lines = []
+    _Progress(tmp_path, 3, 1, [0.5], lines.append)._heartbeat()
+    assert lines and "increment 3 (load factor 0.5): Newton iteration 1, relative residual 1.23e-02" in lines[0]

@@ -415,12 +415,15 @@ def _resume(root: Path) -> tuple[RunFiles, Scene, State]:
 
 
 class _Progress:
-    """Prints a line per committed increment while FreeFEM runs (watches the `done` markers)."""
+    """Prints a line per committed increment while FreeFEM runs (watches the `done` markers), and every
+    ``HEARTBEAT`` seconds of a long increment its last Newton row."""
+
+    HEARTBEAT = 10.0
 
     def __init__(self, fem: Path, inc0: int, count: int, loads: list[float], progress):
         self.fem, self.inc0, self.count, self.loads, self.progress = fem, inc0, count, list(loads), progress
         self.stop = threading.Event()
-        self.t0 = time.perf_counter()
+        self.t0 = self.last_line = time.perf_counter()
 
     def __enter__(self):
         self.thread = threading.Thread(target=self._watch, daemon=True)
@@ -436,6 +439,21 @@ class _Progress:
     def _watch(self):
         while not self.stop.wait(0.5):
             self._report()
+            if self.count > 0 and time.perf_counter() - self.last_line > self.HEARTBEAT:
+                self._heartbeat()
+
+    def _heartbeat(self):
+        self.last_line = time.perf_counter()
+        csv_path = self.fem / f"inc-{self.inc0:04d}" / "newton.csv"
+        try:
+            rows = csv_path.read_text().splitlines()
+        except OSError:
+            rows = []
+        row = rows[-1].split(",") if len(rows) > 1 else None
+        where = f"Newton iteration {row[2]}, relative residual {float(row[4]):.2e}" if row and len(row) > 4 \
+            else "setting up"
+        self.progress(f"  increment {self.inc0} (load factor {self.loads[0]:g}): {where}, "
+                      f"{time.perf_counter() - self.t0:.0f} s")
 
     def _report(self):
         while self.count > 0:
@@ -451,3 +469,5 @@ class _Progress:
                           f"{time.perf_counter() - self.t0:.1f} s")
             self.inc0 += 1
             self.count -= 1
+            self.loads.pop(0)
+            self.last_line = time.perf_counter()
