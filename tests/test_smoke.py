@@ -90,3 +90,17 @@ def test_study_against_the_finest_run(tmp_path):
     assert len(rows) == 2           # the finest run is the reference
     errs = [float(r["error_strain_energy"]) for r in rows]
     assert errs[1] < errs[0]
+
+
+def test_np_override_puts_a_plastic_scene_on_two_ranks(tmp_path):
+    """`--np 2` on a scene with the default direct solver switches it to ffddm; same answer as 1 rank."""
+    from wendel.cli import main
+
+    assert main(["run", str(WORKFLOWS / "cylinder.toml"), "--smoke", "--np", "2", "--out", str(tmp_path / "np2")]) == 0
+    one = run(WORKFLOWS / "cylinder.toml", smoke=True, out=tmp_path / "np1", png=False, progress=lambda *_: None)
+    s2 = json.loads((tmp_path / "np2" / "summary.json").read_text())
+    assert s2["ranks"] == 2 and s2["solver"] == "ffddm"
+    last = f"inc-{s2['increments']:04d}"
+    u1 = output.read_array(one / "fem" / last / "u.node.txt")
+    u2 = output.read_array(tmp_path / "np2" / "fem" / last / "u.node.txt")
+    assert np.abs(u1 - u2).max() <= 1e-8 * np.abs(u1).max()

@@ -101,9 +101,9 @@ def run(scene_path: str | Path, smoke: bool = False, ranks: int | None = None, o
     if png is not None:
         scene.output.png = png
     if ranks is not None:
-        scene.numerics.ranks = ranks
         if ranks > 1:
-            scene.numerics.solver = "ffddm"
+            scene.numerics.solver = "ffddm"      # first: the schema refuses other solvers on several ranks
+        scene.numerics.ranks = ranks
     return run_scene(scene, scene_path, Path(out) if out else _new_run_dir(scene_path, smoke), smoke, progress)
 
 
