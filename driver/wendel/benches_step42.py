@@ -90,7 +90,8 @@ def step42(quick: bool, workdir: Path) -> list[dict]:
     sizes = [0.2, 0.1] if quick else [0.2, 0.1, 0.07, 0.05]
     rows = []
     for h in sizes:
-        for solver in ("direct", "cg"):
+        # UMFPACK64 at h = 0.05 (119k DoFs) had not finished 9 factorizations after 18 min here: CG only there
+        for solver in (("direct", "cg") if h >= 0.07 else ("cg",)):
             rows.append(_row(f"ball h={h:g}", _run_measured(ball, workdir / f"ball-h{h:g}-{solver}", h=h, solver=solver)))
     rows.append(_row("stamp h=0.1", _run_measured(stamp, workdir / "stamp-h0.1", solver="cg")))
     h_par = 0.2 if quick else 0.1
@@ -117,7 +118,9 @@ def plot_force_vs_time(png: Path, rows: list[dict], dealii: list[tuple] | None =
             ax.plot([p[0] for p in pts], [p[1] for p in pts], marker, label=f"wendel P1, graded gmsh mesh ({solver})")
             for t, f, n in pts:
                 ax.annotate(f"{n:,}", (t, f), fontsize=7, xytext=(4, 4), textcoords="offset points")
-    ax.plot([d[5] for d in dealii], [d[4] for d in dealii], "k^--", label="deal.II step-42 Q1 (9.4.1, 1 rank)")
+    for kind, style in (("global", "k^--"), ("adaptive", "kv:")):
+        pts = [d for d in dealii if d[0].startswith(kind)]
+        ax.plot([d[5] for d in pts], [d[4] for d in pts], style, label=f"deal.II step-42 Q1, {kind} (9.4.1, 1 rank)")
     for d in dealii:
         ax.annotate(f"{d[1]:,}", (d[5], d[4]), fontsize=7, xytext=(4, -10), textcoords="offset points")
     ax.axhspan(FINE_FORCE * 0.98, FINE_FORCE * 1.02, color="green", alpha=0.12, label="within 2% of ~55 (fine mesh)")
