@@ -142,6 +142,20 @@ def test_obstacle_that_never_touches_gives_the_elastic_solution(meshes, tmp_path
     assert np.abs(ue).max() > 0 and np.abs(uc - ue).max() <= 1e-12 * np.abs(ue).max()
 
 
+def test_stamp_that_never_touches_an_unloaded_cube(tmp_path):
+    # Nothing loads the cube and the height map stays 0.5 m above it: zero displacement, no active node,
+    # KKT numbers of 0 (not 0/0) through the step-42 entry and its CG path.
+    text = (WORKFLOWS / "stamp-indent.toml").read_text()
+    assert "center = [0.5, 0.5, 1.999]" in text
+    scene = tmp_path / "stamp-away.toml"
+    scene.write_text(text.replace("center = [0.5, 0.5, 1.999]", "center = [0.5, 0.5, 2.5]"))
+    root = run(scene, smoke=True, out=tmp_path / "run", progress=lambda *_: None)
+    last = json.loads((root / "summary.json").read_text())["last_increment"]
+    assert last["contact_active_nodes"] == 0 and last["contact_force"] == 0
+    assert last["max_displacement"] == 0 and all(last[k] == 0 for k in KKT)
+    assert last["contact_min_gap_undeformed"] > 0.4
+
+
 def test_initially_penetrating_plane_is_pushed_out(meshes, tmp_path):
     rec = contact_2d(meshes, tmp_path / "p", "block", "-contact_obstacle", 1, "-contact_cy", -0.05)
     assert rec["contact_min_gap_undeformed"] == pytest.approx(-0.05)
