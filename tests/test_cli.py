@@ -39,3 +39,13 @@ def test_run_failure_exit_code(tmp_path, scene_file, capsys):
     assert main(["run", str(path), "--smoke", "--out", str(tmp_path / "r")]) == 1
     err = capsys.readouterr().err
     assert "even after 1 step halvings" in err and "0 accepted increments are kept" in err
+
+
+def test_relative_run_folder(tmp_path, monkeypatch, capsys):
+    # FreeFEM runs inside the run folder: a relative --out (and --resume) must still reach the mesh
+    monkeypatch.chdir(tmp_path)
+    scene = ROOT / "workflows" / "smoke-mms.toml"
+    assert main(["run", str(scene), "--smoke", "--out", "rel/run"]) == 0
+    assert (tmp_path / "rel" / "run" / "summary.json").is_file()
+    assert main(["run", "--resume", "rel/run"]) == 0
+    assert "rel/run" in capsys.readouterr().out

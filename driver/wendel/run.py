@@ -88,7 +88,7 @@ def run(scene_path: str | Path, smoke: bool = False, ranks: int | None = None, o
     given from its last checkpoint.
     """
     if resume is not None:
-        files, scene, state = _resume(Path(resume))
+        files, scene, state = _resume(Path(resume).resolve())
         progress(f"resuming {files.root} after increment {state.last[0]} (load factor {state.last[1]:g})")
         return _execute(scene, files, state, progress)
     scene_path = Path(scene_path)
@@ -109,7 +109,7 @@ def run(scene_path: str | Path, smoke: bool = False, ranks: int | None = None, o
 
 def run_scene(scene: Scene, scene_path: Path, out: Path, smoke: bool = False, progress=print) -> Path:
     """Run an already validated scene (read from ``scene_path``) into the folder ``out``."""
-    files = RunFiles(Path(out))
+    files = RunFiles(Path(out).resolve())      # FreeFEM runs inside the run folder: paths must be absolute
     files.root.mkdir(parents=True, exist_ok=True)
     report.write_provenance(files.root, Path(scene_path), scene, smoke)
     state = State(pending=scene.loading.load_factors())

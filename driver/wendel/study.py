@@ -41,7 +41,7 @@ def study(scene_path: str | Path, levels: int = 3, smoke: bool = False, ranks: i
         raise ValueError("--levels must be at least 2")
     scene_path = Path(scene_path)
     scene = load(scene_path, smoke=smoke)
-    root = Path(out) if out else RESULTS / scene_path.stem / ("study-" + time.strftime("%Y%m%d-%H%M%S"))
+    root = Path(out).resolve() if out else RESULTS / scene_path.stem / ("study-" + time.strftime("%Y%m%d-%H%M%S"))
     root.mkdir(parents=True, exist_ok=True)
     rows = []
     for k in range(levels):
