@@ -106,3 +106,16 @@ def test_ball_indent_same_result_on_1_and_2_ranks(tmp_path):
     assert a["contact_active_nodes"] == b["contact_active_nodes"]
     assert b["contact_force"] == pytest.approx(a["contact_force"], rel=1e-8)
     assert b["plastic_volume"] == pytest.approx(a["plastic_volume"], rel=1e-8)
+
+
+def test_study_plots_the_force_next_to_dealii(tmp_path):
+    from wendel.study import study
+
+    root = study(WORKFLOWS / "ball-indent.toml", levels=2, smoke=True, out=tmp_path / "s", progress=lambda *_: None)
+    import csv
+
+    with open(root / "study.csv") as f:
+        rows = list(csv.DictReader(f))
+    assert len(rows) == 1 and float(rows[0]["contact_force"]) > 0      # the finest level is the reference
+    png = root / "contact_force_vs_runtime.png"
+    assert png.is_file() and png.stat().st_size > 10_000

@@ -16,6 +16,7 @@ from typing import Literal, Optional
 from pydantic import BaseModel, ConfigDict, Field, create_model, field_validator, model_validator
 
 from .blocks import BLOCKS, PROBLEMS, choice, load_all
+from .comparisons import COMPARISONS
 from .meshes import BUILDERS
 
 # Names a scene may use, mapped to the integer ids of edp/lib/loads.idp (never code).
@@ -26,6 +27,7 @@ SOLVERS = ("direct", "cg", "ffddm")
 BodyForceName = choice(BODY_FORCES, "body force")
 SolverName = choice(SOLVERS, "solver")
 AnalyticName = choice(ANALYTIC_REFERENCES, "analytic reference")
+ComparisonName = choice(COMPARISONS, "comparison")
 
 
 class Strict(BaseModel):
@@ -178,6 +180,8 @@ class Reference(Strict):
     errors: list[str] = Field(default_factory=list,
                               description="record.json keys of errors against closed forms, e.g. error_hertz_p0")
     quantity: str = Field("strain_energy", description="record.json quantity compared with the finest run")
+    compare: Optional[ComparisonName] = Field(
+        None, description=f"another code's figures of the quantity, plotted by wendel study: {', '.join(COMPARISONS)}")
 
 
     @field_validator("errors")

@@ -4,7 +4,9 @@ Level k runs the scene with element size h / 2^k (and the size of a refined zone
 scaled alike). The error is against the scene's analytic
 reference (relative L2 and H1 norms computed by FreeFEM with a high-order quadrature) when it
 declares one, else against the finest run's ``reference.quantity``. Writes study.csv and
-error_vs_runtime.png (log-log, observed convergence rates in the legend).
+error_vs_runtime.png (log-log, observed convergence rates in the legend). A scene whose reference names
+another code's figures (``reference.compare``) also gets ``<quantity>_vs_runtime.png``: the quantity of
+every level against its wall time next to those figures.
 """
 
 from __future__ import annotations
@@ -15,6 +17,8 @@ import math
 import time
 from pathlib import Path
 
+from .comparisons import COMPARISONS
+from .comparisons import plot as plot_quantity
 from .run import RESULTS, run
 from .scene import load
 
@@ -55,6 +59,7 @@ def study(scene_path: str | Path, levels: int = 3, smoke: bool = False, ranks: i
                      "solve_time": s["wall_time_by_phase"]["assembly"] + s["wall_time_by_phase"]["linear_solve"]
                      + s["wall_time_by_phase"]["constitutive"],
                      "newton_iterations": s["newton_iterations"], "last": last})
+    all_rows = list(rows)
     analytic = scene.reference.analytic is not None or bool(scene.reference.errors)
     names = []
     if scene.reference.analytic is not None:
@@ -78,20 +83,31 @@ def study(scene_path: str | Path, levels: int = 3, smoke: bool = False, ranks: i
                            f"{', '.join(k for k, v in rows[-1]['last'].items() if isinstance(v, (int, float)))}")
         for r in rows:
             r[f"error_{q}"] = abs(r["last"][q] - ref) / abs(ref) if ref else abs(r["last"][q] - ref)
-        rows = rows[:-1]
+        rows = rows[:-1]          # the finest run is the reference: no error of its own
         names = [f"error_{q}"]
+    q = scene.reference.quantity
+    for r in rows:
+        if q in r["last"]:
+            r[q] = r["last"][q]
     hs = [r["h"] for r in rows]
     for name in names:
         for r, rate in zip(rows, rates(hs, [r[name] for r in rows])):
             r[f"rate_{name.removeprefix('error_')}"] = rate
     cols = ["level", "h", "h_max", "dofs", "newton_iterations", "wall_time", "solve_time"] + \
-        [c for c in rows[0] if c.startswith(("error_", "rate_"))]
+        ([q] if q in rows[0] else []) + [c for c in rows[0] if c.startswith(("error_", "rate_"))]
     with open(root / "study.csv", "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=cols, extrasaction="ignore")
         w.writeheader()
         w.writerows(rows)
     plot(root / "error_vs_runtime.png", rows, names, scene_path.stem,
          "closed-form reference" if analytic else f"finest run ({levels - 1} levels shown)")
+    if scene.reference.compare is not None:
+        comparison = COMPARISONS[scene.reference.compare]
+        levels_q = [r for r in all_rows if comparison.quantity in r["last"]]
+        for r in levels_q:
+            r[comparison.quantity] = r["last"][comparison.quantity]
+        plot_quantity(root / f"{comparison.quantity}_vs_runtime.png", levels_q, comparison.quantity,
+                      scene_path.stem, comparison)
     return root
 
 
