@@ -109,4 +109,9 @@ def load_all() -> dict[str, Block]:
     """Import every block module of this package (each registers itself) and return the registry."""
     for info in pkgutil.iter_modules(__path__):
         importlib.import_module(f"{__name__}.{info.name}")
+    # one order whatever imported a block first (the scene model, its key table and the README follow it)
+    for registry in (BLOCKS, PROBLEMS):
+        items = sorted(registry.items())
+        registry.clear()
+        registry.update(items)
     return BLOCKS
