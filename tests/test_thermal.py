@@ -103,3 +103,12 @@ def test_heated_ball_on_elastic_block_energy_balance(tmp_path, scene_file):
     stored = last["thermal_energy_change"]
     sources = last["heat_contact"] + last["heat_boundary"] + last["heat_thermoelastic"] + last["heat_plastic"]
     assert abs(stored - sources) <= 0.01 * abs(stored)
+
+
+def test_monolithic_coupling_with_an_iterative_solver_is_refused_at_check(scene_file):
+    from wendel.scene import SceneError, load
+
+    text = (WORKFLOWS / "thermo-mms.toml").read_text()
+    assert 'solver = "direct"' in text
+    with pytest.raises(SceneError, match=r'monolithic.*needs numerics.solver = "direct", not \'cg\''):
+        load(scene_file(text.replace('solver = "direct"', 'solver = "cg"')))
