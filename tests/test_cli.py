@@ -49,3 +49,18 @@ def test_relative_run_folder(tmp_path, monkeypatch, capsys):
     assert (tmp_path / "rel" / "run" / "summary.json").is_file()
     assert main(["run", "--resume", "rel/run"]) == 0
     assert "rel/run" in capsys.readouterr().out
+
+
+def test_bench_help_names_every_benchmark(capsys):
+    import pytest
+
+    from wendel.bench import BENCHES, OPT_IN, _load_plugins
+
+    _load_plugins()
+    with pytest.raises(SystemExit):
+        main(["bench", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    readme = (ROOT / "README.md").read_text()
+    for name in BENCHES:
+        assert name in text and f"`{name}`" in readme, name
+    assert OPT_IN <= set(BENCHES)
