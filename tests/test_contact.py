@@ -100,6 +100,16 @@ def contact_2d(meshes, out: Path, mesh: str, *extra, ranks: int = 1, dirichlet=(
     return solve("solve-2d-contact.edp", out, *opts, *extra, ranks=ranks)
 
 
+def test_hertz_3d_sphere(tmp_path):
+    # P1 tetrahedra, h/25 at the contact (11.6k DoFs): the contact radius from the active area within 2%
+    # (measured 0.7%); the peak pressure is a nodal multiplier, 4-6% off on these meshes (measured 4.9%).
+    root = run(WORKFLOWS / "hertz-3d.toml", out=tmp_path / "h3", png=False, progress=lambda *_: None)
+    last = json.loads((root / "summary.json").read_text())["last_increment"]
+    assert last["error_contact_size"] < 0.02 and last["error_max_pressure"] < 0.08
+    assert all(last[k] < 1e-8 for k in KKT)
+    assert last["contact_active_nodes"] > 100
+
+
 def test_hertz_scene_within_5_percent(tmp_path):
     root = run(WORKFLOWS / "hertz.toml", out=tmp_path / "hertz", progress=lambda *_: None)
     s = json.loads((root / "summary.json").read_text())
