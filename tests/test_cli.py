@@ -64,3 +64,13 @@ def test_bench_help_names_every_benchmark(capsys):
     for name in BENCHES:
         assert name in text and f"`{name}`" in readme, name
     assert OPT_IN <= set(BENCHES)
+
+
+def test_run_prints_the_errors_against_the_reference(tmp_path, capsys):
+    assert main(["run", str(ROOT / "workflows" / "smoke-mms.toml"), "--smoke", "--out", str(tmp_path / "m")]) == 0
+    out = capsys.readouterr().out
+    line = next(l for l in out.splitlines() if l.startswith("relative error against the analytic reference"))
+    l2 = float(line.split("L2 ")[1].split(",")[0])
+    assert 0 < l2 < 0.5                                  # relative, not the absolute L2 norm
+    assert main(["run", str(ROOT / "workflows" / "hertz.toml"), "--smoke", "--out", str(tmp_path / "h")]) == 0
+    assert "errors against the closed form: contact_size " in capsys.readouterr().out
