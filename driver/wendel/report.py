@@ -142,7 +142,7 @@ def write_summary(root: Path, scene, state, dimension: int) -> dict:
         "share_startup_and_io": (phases["freefem_startup"] + phases["freefem_output"] + phases["driver_output"]) / total
         if total else None,
         "remeshes": state.remeshes,
-        "errors": {k: v for k, v in last.items() if k.startswith("error_") and isinstance(v, (int, float)) and v >= 0},
+        "errors": _errors(last),
         "last_increment": last,
     }
     prov_path = root / "provenance.json"
@@ -154,3 +154,18 @@ def write_summary(root: Path, scene, state, dimension: int) -> dict:
     tmp.write_text(json.dumps(summary, indent=1))
     os.replace(tmp, root / "summary.json")
     return summary
+
+
+def _errors(last: dict) -> dict:
+    """The errors of the last increment: closed-form ones as computed (relative where the module makes them
+    so), the analytic L2 and H1 errors also relative to the reference field's norms.
+
+    >>> _errors({"error_l2": 0.5, "reference_l2": 2.0, "error_h1": -1, "error_p0": 0.01})
+    {'error_l2': 0.5, 'error_p0': 0.01, 'error_l2_relative': 0.25}
+    """
+    out = {k: v for k, v in last.items() if k.startswith("error_") and isinstance(v, (int, float)) and v >= 0}
+    for norm in ("l2", "h1"):
+        ref = last.get(f"reference_{norm}", -1)
+        if f"error_{norm}" in out and isinstance(ref, (int, float)) and ref > 0:
+            out[f"error_{norm}_relative"] = out[f"error_{norm}"] / ref
+    return out
