@@ -74,3 +74,21 @@ def test_run_prints_the_errors_against_the_reference(tmp_path, capsys):
     assert 0 < l2 < 0.5                                  # relative, not the absolute L2 norm
     assert main(["run", str(ROOT / "workflows" / "hertz.toml"), "--smoke", "--out", str(tmp_path / "h")]) == 0
     assert "errors against the closed form: contact_size " in capsys.readouterr().out
+
+
+def test_a_used_run_folder_is_refused(tmp_path, capsys):
+    scene = str(ROOT / "workflows" / "smoke-mms.toml")
+    out = tmp_path / "r"
+    assert main(["run", scene, "--smoke", "--out", str(out)]) == 0
+    before = (out / "summary.json").read_text()
+    assert main(["run", scene, "--smoke", "--out", str(out)]) == 2
+    assert "exists and is not empty" in capsys.readouterr().err
+    assert (out / "summary.json").read_text() == before              # nothing of the first run is touched
+
+
+def test_parallel_runs_of_one_scene_get_their_own_folders(tmp_path, monkeypatch):
+    import wendel.run as runmod
+
+    monkeypatch.setattr(runmod, "RESULTS", tmp_path)
+    dirs = [runmod._new_run_dir(Path("workflows/smoke.toml"), smoke=True) for _ in range(3)]
+    assert len(set(dirs)) == 3 and all(d.is_dir() and not any(d.iterdir()) for d in dirs)

@@ -80,7 +80,8 @@ def _load_plugins() -> None:
 
 
 def run_summary(scene: Path, workdir: Path, **kw) -> dict:
-    """Run a scene quietly without a picture and return its summary.json."""
+    """Run a scene quietly without a picture into the scratch folder ``workdir`` and return its summary.json."""
+    shutil.rmtree(workdir, ignore_errors=True)
     root = run(scene, out=workdir, png=False, progress=lambda *_: None, **kw)
     return json.loads((root / "summary.json").read_text())
 

@@ -110,6 +110,10 @@ def run(scene_path: str | Path, smoke: bool = False, ranks: int | None = None, o
 def run_scene(scene: Scene, scene_path: Path, out: Path, smoke: bool = False, progress=print) -> Path:
     """Run an already validated scene (read from ``scene_path``) into the folder ``out``."""
     files = RunFiles(Path(out).resolve())      # FreeFEM runs inside the run folder: paths must be absolute
+    if files.root.is_dir() and any(files.root.iterdir()):
+        # never mix a new run with the files of another (nor delete them): a new folder, or --resume
+        raise ValueError(f"run folder {files.root} exists and is not empty: choose another --out, or continue "
+                         f"the run in it with `wendel run --resume {files.root}`")
     files.root.mkdir(parents=True, exist_ok=True)
     report.write_provenance(files.root, Path(scene_path), scene, smoke)
     state = State(pending=scene.loading.load_factors())
@@ -378,10 +382,13 @@ def _new_run_dir(scene_path: Path, smoke: bool) -> Path:
     stamp = time.strftime("%Y%m%d-%H%M%S")
     base = RESULTS / scene_path.stem / (stamp + ("-smoke" if smoke else ""))
     d, k = base, 1
-    while d.exists():
-        k += 1
-        d = base.with_name(f"{base.name}-{k}")
-    return d
+    while True:                        # created here, atomically: parallel runs of a sweep get their own
+        try:
+            d.mkdir(parents=True)
+            return d
+        except FileExistsError:
+            k += 1
+            d = base.with_name(f"{base.name}-{k}")
 
 
 def _save_checkpoint(files: RunFiles, scene: Scene, state: State, dimension: int) -> None:
