@@ -16,7 +16,7 @@ import time
 from pathlib import Path
 from typing import Callable
 
-from .run import RESULTS, run
+from .run import RESULTS
 
 BENCHES: dict[str, Callable[[bool, Path], list[dict]]] = {}
 OPT_IN = {"step42-dealii"}
@@ -77,13 +77,6 @@ def _load_plugins() -> None:
     for info in pkgutil.iter_modules(wendel.__path__):
         if info.name.startswith("benches_"):
             importlib.import_module(f"wendel.{info.name}")
-
-
-def run_summary(scene: Path, workdir: Path, **kw) -> dict:
-    """Run a scene quietly without a picture into the scratch folder ``workdir`` and return its summary.json."""
-    shutil.rmtree(workdir, ignore_errors=True)
-    root = run(scene, out=workdir, png=False, progress=lambda *_: None, **kw)
-    return json.loads((root / "summary.json").read_text())
 
 
 WORKFLOWS = Path(__file__).resolve().parents[2] / "workflows"

@@ -29,7 +29,7 @@ from .bench import WORKFLOWS, register
 
 DEALII_EXAMPLE = Path("/usr/share/doc/libdeal.ii-doc/examples/step-42")
 
-from .comparisons import DEALII_REFERENCE, DEALII_STAMP_REFERENCE, FINE_FORCE  # noqa: F401 (the figures)
+from .comparisons import DEALII_REFERENCE, FINE_FORCE
 
 
 def _run_measured(scene: Path, out: Path, h: float | None = None, solver: str | None = None,

@@ -247,11 +247,9 @@ class SceneBase(Strict):
             extra = sorted(present - allowed)
             if extra:
                 raise ValueError(f"problem {self.problem!r} does not use the table(s) {', '.join(extra)}")
-        thermal = getattr(self, "thermal", None)
-        if thermal is not None and thermal.coupling == "monolithic" and self.numerics.solver != "direct":
-            raise ValueError(f"thermal.coupling = \"monolithic\" solves the non-symmetric (u, T) system: it needs "
-                             f"numerics.solver = \"direct\", not {self.numerics.solver!r} (or thermal.coupling = "
-                             f"\"staggered\")")
+        for name, block in BLOCKS.items():
+            if block.check is not None and getattr(self, name, None) is not None:
+                block.check(getattr(self, name), self)
         if self.body_force.kind == "manufactured" and self.reference.analytic is None:
             raise ValueError("body_force.kind = \"manufactured\" needs reference.analytic")
         return self

@@ -60,6 +60,11 @@ def study(scene_path: str | Path, levels: int = 3, smoke: bool = False, ranks: i
                      + s["wall_time_by_phase"]["constitutive"],
                      "newton_iterations": s["newton_iterations"], "last": last})
     all_rows = list(rows)
+    comparison = COMPARISONS[scene.reference.compare] if scene.reference.compare is not None else None
+    for r in rows:                     # the reference quantity (study.csv) and the compared one (picture)
+        for key in {scene.reference.quantity} | ({comparison.quantity} if comparison else set()):
+            if key in r["last"]:
+                r[key] = r["last"][key]
     analytic = scene.reference.analytic is not None or bool(scene.reference.errors)
     names = []
     if scene.reference.analytic is not None:
@@ -86,9 +91,6 @@ def study(scene_path: str | Path, levels: int = 3, smoke: bool = False, ranks: i
         rows = rows[:-1]          # the finest run is the reference: no error of its own
         names = [f"error_{q}"]
     q = scene.reference.quantity
-    for r in rows:
-        if q in r["last"]:
-            r[q] = r["last"][q]
     hs = [r["h"] for r in rows]
     for name in names:
         for r, rate in zip(rows, rates(hs, [r[name] for r in rows])):
@@ -101,11 +103,8 @@ def study(scene_path: str | Path, levels: int = 3, smoke: bool = False, ranks: i
         w.writerows(rows)
     plot(root / "error_vs_runtime.png", rows, names, scene_path.stem,
          "closed-form reference" if analytic else f"finest run ({levels - 1} levels shown)")
-    if scene.reference.compare is not None:
-        comparison = COMPARISONS[scene.reference.compare]
-        levels_q = [r for r in all_rows if comparison.quantity in r["last"]]
-        for r in levels_q:
-            r[comparison.quantity] = r["last"][comparison.quantity]
+    if comparison is not None:
+        levels_q = [r for r in all_rows if comparison.quantity in r]
         plot_quantity(root / f"{comparison.quantity}_vs_runtime.png", levels_q, comparison.quantity,
                       scene_path.stem, comparison)
     return root

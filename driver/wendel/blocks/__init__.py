@@ -14,7 +14,7 @@ from __future__ import annotations
 import dataclasses
 import importlib
 import pkgutil
-from typing import Any, Callable
+from typing import Any, Callable, Optional
 
 from pydantic import AfterValidator, BaseModel
 from typing_extensions import Annotated
@@ -54,6 +54,9 @@ class Block:
     mechanics : bool
         True for a module of the mechanics entry scripts; False for the table of a scalar problem
         (see :class:`Problem`), which mechanics scenes refuse.
+    check : callable or None
+        ``check(block, scene)``: rules that join this table with others, applied when the scene is read
+        (``wendel check``); raises ValueError naming the keys.
     """
 
     name: str
@@ -61,6 +64,7 @@ class Block:
     options: Callable[[Any, Any, Any], list[str]]
     fields: tuple[str, ...] = ()
     mechanics: bool = True
+    check: Optional[Callable[[Any, Any], None]] = None
 
 
 BLOCKS: dict[str, Block] = {}

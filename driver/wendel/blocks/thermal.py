@@ -129,4 +129,12 @@ def options(block: Thermal, scene, files) -> list[str]:
     return opts
 
 
-register(Block(name="thermal", model=Thermal, options=options, fields=("T", "mean_stress")))
+def check(block: Thermal, scene) -> None:
+    """Rules joining [thermal] with other tables, applied when the scene is read."""
+    if block.coupling == "monolithic" and scene.numerics.solver != "direct":
+        raise ValueError(f"thermal.coupling = \"monolithic\" solves the non-symmetric (u, T) system: it needs "
+                         f"numerics.solver = \"direct\", not {scene.numerics.solver!r} (or thermal.coupling = "
+                         f"\"staggered\")")
+
+
+register(Block(name="thermal", model=Thermal, options=options, fields=("T", "mean_stress"), check=check))
