@@ -25,14 +25,14 @@ BAD = [
     (("h = 0.025", "h = \"fine\""), "geometry.h", "valid number"),
     (("[material]", "[material]\nrho = 7800.0"), "material.rho", "unknown key"),
     (("[numerics]", "[numerix]"), "numerix", "unknown key"),
-    (("builder = \"rectangle\"", "builder = \"hexagon\""), "geometry", "unknown builder 'hexagon'; valid: box,"),
+    (("builder = \"rectangle\"", "builder = \"hexagon\""), "geometry", "unknown builder 'hexagon'; valid: axi_rectangle, box,"),
     (("x = [-1.0, 1.0]", "x = [-1.0, 1.0]\nradius = 2.0"), "geometry", "unknown key(s) radius for builder 'rectangle'"),
     (("solver = \"ffddm\"", "solver = \"petsc\""), "numerics.solver", "unknown solver 'petsc'; valid: direct, cg, ffddm"),
     (("ranks = 1", "ranks = 0"), "numerics.ranks", "greater than or equal to 1"),
     (("kind = \"step8-discs\"", "kind = \"gravity\""), "body_force.kind", "unknown body force 'gravity'"),
     (("[boundary.left]", "[boundary.west]"), "boundary.west", "unknown boundary name"),
     (("steps = 1", "steps = 0"), "loading.steps", "greater than or equal to 1"),
-    (("plane = \"strain\"", "plane = \"membrane\""), "elasticity.plane", "'strain' or 'stress'"),
+    (("plane = \"strain\"", "plane = \"membrane\""), "elasticity.plane", "'strain', 'stress' or 'axisymmetric'"),
     (("ranks = 1\nsolver = \"ffddm\"", "ranks = 2\nsolver = \"direct\""), "numerics", "runs on one rank"),
     (("description = ", "descr = "), "description", "Field required"),
 ]
@@ -122,6 +122,10 @@ def test_values_reach_freefem_as_numbers_only(tmp_path):
         scene = load(path)
         files = RunFiles(tmp_path / path.stem)
         opts = options(scene, files, 3 if scene.geometry.builder == "box" else 2)
+        # -D macros (modules, -DAXISYMMETRIC=1, -DPk=P2) come from fixed driver strings, never from the scene
+        macros = [o for o in opts if o.startswith("-D")]
+        assert set(macros) <= {"-DAXISYMMETRIC=1", "-DPk=P2"}, (path.name, macros)
+        opts = [o for o in opts if not o.startswith("-D")]
         values = opts[1::2]
         for key, value in zip(opts[0::2], values):
             assert key.startswith("-"), (path.name, key)

@@ -13,7 +13,7 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from . import freefem, output, remeshing, report
+from . import axisymmetric, freefem, output, remeshing, report
 from .blocks import BLOCKS, PROBLEMS
 from .meshes import LABELS, build as build_mesh
 from .schema import ANALYTIC_REFERENCES, BODY_FORCES, Scene
@@ -346,6 +346,7 @@ def options(scene: Scene, files: RunFiles, dimension: int, segment: dict | None 
     opts += ["-mat_E", repr(m.E), "-mat_nu", repr(m.nu),
              "-el_plane_stress", "1" if scene.elasticity.plane == "stress" else "0",
              "-bc", str(files.tables / "bc.txt"), "-trac", str(files.tables / "trac.txt")]
+    opts += axisymmetric.options(scene, dimension)
     for key in ("ubase", "eps0"):
         if segment.get(key):
             opts += [f"-{key}", str(files.root / segment[key])]

@@ -17,6 +17,7 @@ from pydantic import BaseModel, ConfigDict, Field, create_model, field_validator
 
 from .blocks import BLOCKS, PROBLEMS, choice, load_all
 from .comparisons import COMPARISONS
+from .axisymmetric import REFERENCES as AXI_REFERENCES
 from .meshes import BUILDERS
 
 # Names a scene may use, mapped to the integer ids of edp/lib/loads.idp (never code).
@@ -28,6 +29,7 @@ BodyForceName = choice(BODY_FORCES, "body force")
 SolverName = choice(SOLVERS, "solver")
 AnalyticName = choice(ANALYTIC_REFERENCES, "analytic reference")
 ComparisonName = choice(COMPARISONS, "comparison")
+AxiReferenceName = choice(AXI_REFERENCES, "axisymmetric reference")
 
 
 class Strict(BaseModel):
@@ -80,7 +82,12 @@ class Material(Strict):
 class Elasticity(Strict):
     """Options of the elastic part (present in every mechanical scene)."""
 
-    plane: Literal["strain", "stress"] = Field("strain", description="2D hypothesis")
+    plane: Literal["strain", "stress", "axisymmetric"] = Field(
+        "strain", description="2D hypothesis; axisymmetric: x = r >= 0, y = z, hoop strain and 2 pi r weights")
+    order: int = Field(1, ge=1, le=2, description="Lagrange order of the displacement; 2: 2D elastic scenes "
+                       "without remeshing (edp/solve-2d.edp)")
+    reference: Optional[AxiReferenceName] = Field(
+        None, description=f"closed form of an axisymmetric scene: {', '.join(AXI_REFERENCES)}")
 
 
 class Boundary(Strict):

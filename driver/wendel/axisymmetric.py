@@ -1,0 +1,55 @@
+"""Axisymmetric (r, z) scenes: ``elasticity.plane = "axisymmetric"`` on a 2D mesh with x = r >= 0, y = z.
+
+The driver adds ``-DAXISYMMETRIC=1`` to the FreeFEM command line (edp/lib/axisymmetric.idp: the hoop strain
+and the 2 pi r weights) and the options of the closed-form references of ``elasticity.reference``
+(a registry: name -> options function).
+
+>>> sorted(REFERENCES)
+['thick-sphere']
+"""
+
+from __future__ import annotations
+
+from typing import Callable
+
+
+def _thick_sphere(scene) -> list[str]:
+    """Lame's sphere (and, with perfect plasticity, its first-yield and limit pressures): pressure on
+    boundary.inner, radii from the sphere_section builder."""
+    g, inner = scene.geometry, scene.boundary.get("inner")
+    p = g.params
+    if g.builder != "sphere_section" or not p.get("r_inner") or inner is None or not inner.pressure:
+        raise ValueError("elasticity.reference = 'thick-sphere' needs geometry.builder = 'sphere_section' with "
+                         "r_inner > 0 and a pressure on boundary.inner")
+    opts = ["-axi_sphere_p", repr(float(inner.pressure)), "-axi_sphere_a", repr(float(p["r_inner"])),
+            "-axi_sphere_b", repr(float(p.get("r_outer", 1.0)))]
+    plast = getattr(scene, "plasticity", None)
+    if plast is not None:
+        if plast.law != "perfect":
+            raise ValueError("elasticity.reference = 'thick-sphere' with plasticity needs plasticity.law = 'perfect'")
+        opts += ["-axi_sphere_sigma0", repr(float(plast.sigma0))]
+    return opts
+
+
+REFERENCES: dict[str, Callable] = {"thick-sphere": _thick_sphere}
+
+
+def options(scene, dimension: int) -> list[str]:
+    """FreeFEM options of an axisymmetric scene (none for a plane or 3D one), and of ``elasticity.order``."""
+    el = scene.elasticity
+    opts = []
+    if el.order == 2:
+        if dimension != 2 or scene.blocks or scene.remesh is not None or scene.problem != "mechanics":
+            raise ValueError("elasticity.order = 2 is for 2D elastic scenes (no plasticity, contact, thermal "
+                             "or remesh table)")
+        opts += ["-DPk=P2"]
+    if el.plane != "axisymmetric":
+        if el.reference is not None:
+            raise ValueError(f"elasticity.reference = {el.reference!r} needs elasticity.plane = 'axisymmetric'")
+        return opts
+    if dimension != 2:
+        raise ValueError(f"elasticity.plane = 'axisymmetric' needs a 2D (r, z) mesh; this one is {dimension}D")
+    opts += ["-DAXISYMMETRIC=1"]
+    if el.reference is not None:
+        opts += REFERENCES[el.reference](scene)
+    return opts

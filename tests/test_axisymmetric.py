@@ -1,0 +1,58 @@
+"""Axisymmetric (r, z) models (elasticity.plane = "axisymmetric"): Lame's thick sphere, a manufactured
+solution converging at the element order, the axis condition, the refusals."""
+
+from __future__ import annotations
+
+import csv
+import json
+
+import numpy as np
+import pytest
+
+from wendel.run import run
+from wendel.study import study
+
+from conftest import WORKFLOWS
+
+
+def records(fem):
+    return [json.loads((d / "record.json").read_text()) for d in sorted(fem.glob("inc-*")) if (d / "done").is_file()]
+
+
+def test_thick_sphere_stresses_match_lame(tmp_path, quiet):
+    # P2, h = 0.05 m on a sphere a = 1 m, b = 2 m (9300 DoFs): measured 6.3e-4 in L2 and 3.1e-3 at the centroids
+    root = run(WORKFLOWS / "axisym-sphere.toml", out=tmp_path / "run", png=False, progress=quiet)
+    rec = records(root / "fem")[-1]
+    assert rec["dofs"] < 12000
+    assert 0 < rec["error_lame_stress_l2"] < 1e-3, rec["error_lame_stress_l2"]
+    assert 0 < rec["error_lame_stress"] < 4e-3, rec["error_lame_stress"]
+    # u_r = 0 on the axis (the scene names no condition there), u_z free; the bore opens
+    xyz = np.array((root / "fem" / "vertices.txt").read_text().split()[1:], float).reshape(3, -1)
+    u = np.array((root / "fem" / "inc-0001" / "u.node.txt").read_text().split()[1:], float).reshape(-1, 2)
+    on_axis = np.abs(xyz[0]) < 1e-12
+    assert on_axis.sum() > 10 and np.all(u[on_axis, 0] == 0) and np.abs(u[on_axis, 1]).max() > 0
+    # Lame: u(a) = p a / E [(1 - 2 nu) a^3 + (1 + nu) b^3 / 2] / (b^3 - a^3) at the bore
+    p_, a, b, E, nu = 100e6, 1.0, 2.0, 200e9, 0.3
+    ua = p_ * a / E * ((1 - 2 * nu) * a ** 3 + (1 + nu) * b ** 3 / 2) / (b ** 3 - a ** 3)
+    bore = np.abs(np.hypot(xyz[0], xyz[1]) - a) < 1e-9
+    assert np.hypot(u[bore, 0], u[bore, 1]) == pytest.approx(ua, rel=1e-3)
+
+
+def test_axisymmetric_manufactured_solution_converges_at_the_element_order(tmp_path):
+    root = study(WORKFLOWS / "axisym-mms.toml", levels=3, smoke=True, out=tmp_path / "study", progress=lambda *_: None)
+    rows = list(csv.DictReader(open(root / "study.csv")))
+    assert len(rows) == 3
+    assert abs(float(rows[-1]["rate_h1"]) - 1.0) < 0.15     # P1: H1 error ~ h
+    assert abs(float(rows[-1]["rate_l2"]) - 2.0) < 0.15     # L2 error ~ h^2
+    # u_z is free on the axis and u_r = 0 there without a boundary entry: the exact field has both
+    assert float(rows[-1]["error_l2"]) < float(rows[0]["error_l2"]) / 10
+
+
+@pytest.mark.parametrize("change, message", [
+    (("r = [0.0, 1.0]", "r = [-0.5, 1.0]"), "x = r >= 0"),
+    (('plane = "axisymmetric"', 'plane = "strain"\nreference = "thick-sphere"'), "needs elasticity.plane"),
+])
+def test_bad_axisymmetric_scenes_are_refused(tmp_path, scene_file, quiet, change, message):
+    text = (WORKFLOWS / "axisym-mms.toml").read_text().replace(*change)
+    with pytest.raises(Exception, match=message):
+        run(scene_file(text), smoke=True, out=tmp_path / "run", png=False, progress=quiet)
