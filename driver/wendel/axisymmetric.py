@@ -49,6 +49,11 @@ def options(scene, dimension: int) -> list[str]:
         return opts
     if dimension != 2:
         raise ValueError(f"elasticity.plane = 'axisymmetric' needs a 2D (r, z) mesh; this one is {dimension}D")
+    contact = getattr(scene, "contact", None)
+    if contact is not None and contact.obstacle in ("ball", "cylinder"):
+        if contact.obstacle == "cylinder" or contact.center[0] != 0 or contact.normal[1] != "y":
+            raise ValueError("contact in an axisymmetric scene: a ball is a sphere only when centred on the axis "
+                             "(contact.center = [0, z]) and pressed along it (contact.normal = '+y' or '-y')")
     opts += ["-DAXISYMMETRIC=1"]
     if el.reference is not None:
         opts += REFERENCES[el.reference](scene)
