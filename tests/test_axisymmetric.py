@@ -114,3 +114,65 @@ def test_an_off_axis_ball_is_refused(tmp_path, scene_file, quiet):
     text = (WORKFLOWS / "axisym-hertz.toml").read_text().replace("center = [0.0, 1.0] ", "center = [0.3, 1.0] ")
     with pytest.raises(ValueError, match="centred on the axis"):
         run(scene_file(text), smoke=True, out=tmp_path / "run", png=False, progress=quiet)
+
+
+def test_heated_cylinder_thermal_stresses_match_timoshenko_goodier(tmp_path, quiet):
+    # h = 5 mm (2628 DoFs): measured 0.59 % of E alpha (T_a - T_b) / (1 - nu), the largest over cells and components
+    import math
+    root = run(WORKFLOWS / "axisym-heated-cylinder.toml", out=tmp_path / "run", png=False, progress=quiet)
+    rec = records(root / "fem")[-1]
+    assert 0 < rec["error_thermal_stress"] < 0.01, rec["error_thermal_stress"]
+    # the 2 pi r weights of conduction: the steady profile is logarithmic, and the outer temperature of the
+    # bore-heated cylinder cooled by convection is k (T_a - T_b) / (b ln(b/a)) = h (T_b - T_inf)
+    k, hc, a, b, Ta, Tinf = 50.0, 200.0, 0.5, 1.0, 393.15, 293.15
+    g = k / (b * math.log(b / a))
+    assert rec["cylinder_T_outer"] == pytest.approx((g * Ta + hc * Tinf) / (g + hc), rel=1e-5)
+    assert rec["energy_balance_error"] < 1e-6
+    # the staggered coupling reaches the same state
+    text = (WORKFLOWS / "axisym-heated-cylinder.toml").read_text().replace('coupling = "monolithic"', 'coupling = "staggered"')
+    path = tmp_path / "staggered.toml"
+    path.write_text(text)
+    rec2 = records(run(path, out=tmp_path / "run2", png=False, progress=quiet) / "fem")[-1]
+    assert rec2["error_thermal_stress"] == pytest.approx(rec["error_thermal_stress"], rel=1e-6)
+
+
+def test_energy_balance_of_a_heated_axisymmetric_body(tmp_path, quiet):
+    # transient: heat flux into the bore, convection outside, 3 increments of 200 s, staggered coupling
+    text = (WORKFLOWS / "axisym-heated-cylinder.toml").read_text()
+    text = text.replace('coupling = "monolithic"', 'coupling = "staggered"')
+    text = text.replace("duration = 0.0             # s: steady heat equation", "duration = 600.0           # s")
+    text = text.replace("temperature = 393.15       # K, the heated bore", "flux = 2e4                 # W/m^2")
+    text = text.replace("steps = 1", "steps = 3")
+    path = tmp_path / "transient.toml"
+    path.write_text(text)
+    recs = records(run(path, smoke=True, out=tmp_path / "run", png=False, progress=quiet) / "fem")
+    assert len(recs) == 3
+    for r in recs:
+        assert r["thermal_energy_change"] > 0 and r["heat_boundary"] > 0
+        assert r["energy_balance_error"] < 1e-6, r["energy_balance_error"]
+    # the heat that entered through the bore: flux times the area of revolution 2 pi a L times the time
+    # (the convection outside takes some back: heat_boundary is the sum of both)
+    q_in = 2e4 * 2 * 3.141592653589793 * 0.5 * 0.05 * 600.0
+    assert 0.5 * q_in < recs[-1]["heat_boundary"] <= q_in * (1 + 1e-9)
+
+
+def test_adiabatic_heating_of_the_plastic_sphere(tmp_path, quiet):
+    # the elastoplastic sphere heated by its plastic work (adiabatic coupling, Taylor-Quinney 0.9)
+    text = (WORKFLOWS / "axisym-sphere-plastic.toml").read_text()
+    text = text.replace("[boundary.symmetry_y]", """[thermal]
+k = 50.0
+rho = 7800.0
+c = 460.0
+alpha = 0.0
+coupling = "adiabatic"
+duration = 1.0
+
+[boundary.symmetry_y]""")
+    text = text.replace("factors = [1.0, 2.6, 3.2, 3.44, 3.49]", "factors = [1.0, 2.6, 3.2]")
+    path = tmp_path / "adiabatic.toml"
+    path.write_text(text)
+    recs = records(run(path, smoke=True, out=tmp_path / "run", png=False, progress=quiet) / "fem")
+    last = recs[-1]
+    assert last["heat_plastic"] > 0 and last["max_temperature"] > 293.15
+    assert last["heat_plastic"] == pytest.approx(0.9 * last["plastic_work"], rel=1e-9)
+    assert last["energy_balance_error"] < 1e-6

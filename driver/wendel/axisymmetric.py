@@ -5,7 +5,7 @@ and the 2 pi r weights) and the options of the closed-form references of ``elast
 (a registry: name -> options function).
 
 >>> sorted(REFERENCES)
-['thick-sphere']
+['heated-cylinder', 'thick-sphere']
 """
 
 from __future__ import annotations
@@ -31,7 +31,18 @@ def _thick_sphere(scene) -> list[str]:
     return opts
 
 
-REFERENCES: dict[str, Callable] = {"thick-sphere": _thick_sphere}
+def _heated_cylinder(scene) -> list[str]:
+    """Timoshenko-Goodier's hollow cylinder under a steady radial temperature profile (plane strain): radii
+    from the hollow_cylinder_section builder; the thermal table heats it."""
+    g = scene.geometry
+    p = g.params
+    if g.builder != "hollow_cylinder_section" or getattr(scene, "thermal", None) is None:
+        raise ValueError("elasticity.reference = 'heated-cylinder' needs geometry.builder = "
+                         "'hollow_cylinder_section' and a thermal table")
+    return ["-axi_cyl_a", repr(float(p.get("r_inner", 1.0))), "-axi_cyl_b", repr(float(p.get("r_outer", 2.0)))]
+
+
+REFERENCES: dict[str, Callable] = {"heated-cylinder": _heated_cylinder, "thick-sphere": _thick_sphere}
 
 
 def options(scene, dimension: int) -> list[str]:
