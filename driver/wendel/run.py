@@ -252,7 +252,8 @@ def maybe_remesh(scene: Scene, files: RunFiles, state: State, dimension: int, pr
              f"{' (asked by remesh.at)' if not poor else ''}: remeshing")
     rep = remeshing.remesh_state(files.fem / f"inc-{inc:04d}", files.root / seg["mesh"], ubase_old, dimension,
                                  files.root / mesh_new, files.root / state_dir, h, r.h_min or h / 3, r.indicator,
-                                 mu=scene.material.E / (2 * (1 + scene.material.nu)))
+                                 mu=scene.material.E / (2 * (1 + scene.material.nu)),
+                                 axisymmetric=scene.elasticity.plane == "axisymmetric")
     rep.update({"remesh": k, "after_increment": inc, "load_factor": lf})
     state.remeshes.append(rep)
     state.segments.append({"first": inc + 1, "mesh": mesh_new, "ubase": f"{state_dir}/ubase.txt",
