@@ -9,14 +9,26 @@ import json
 import numpy as np
 import pytest
 
-from wendel.run import run
-from wendel.study import study
+from wendel.loop import run
+from wendel.results.study import study
 
 from conftest import WORKFLOWS
 
 
 def records(fem):
     return [json.loads((d / "record.json").read_text()) for d in sorted(fem.glob("inc-*")) if (d / "done").is_file()]
+
+
+def test_axisymmetric_scenes_compile_the_axisymmetric_code_and_plane_ones_do_not(tmp_path):
+    from test_entry import MODULES, compiled
+
+    found, switches, _ = compiled(tmp_path, "axisym-sphere-plastic.toml")
+    assert found & set(MODULES) == {"plasticity", "axisymmetric", "axisymmetric-mechanics"}, found
+    assert switches == ["-Ddimension=2", "-DPk=P1", "-DWITHPLASTICITY=1", "-DAXISYMMETRIC=1"]
+    found, switches, _ = compiled(tmp_path, "axisym-sphere.toml")
+    assert "-DPk=P2" in switches and "axisymmetric" in found
+    found, switches, _ = compiled(tmp_path, "cylinder.toml")            # plane strain: none of it
+    assert not found & {"axisymmetric", "axisymmetric-mechanics"} and "-DAXISYMMETRIC=1" not in switches
 
 
 def test_thick_sphere_stresses_match_lame(tmp_path, quiet):
