@@ -45,6 +45,35 @@ def _heated_cylinder(scene) -> list[str]:
 REFERENCES: dict[str, Callable] = {"heated-cylinder": _heated_cylinder, "thick-sphere": _thick_sphere}
 
 
+AXI_BUILDERS = {"axi_rectangle", "sphere_section", "hollow_cylinder_section", "notched_bar"}
+"""Builders of (r, z) sections; the plane 2D builders work too when their x range is >= 0 (FreeFEM checks)."""
+
+
+def check(scene) -> None:
+    """Rules of ``elasticity.plane/order/reference`` that join other tables, applied when the scene is read."""
+    el, g = scene.elasticity, scene.geometry
+    if el.reference is not None:
+        if el.plane != "axisymmetric":
+            raise ValueError(f"elasticity.reference = {el.reference!r} needs elasticity.plane = 'axisymmetric'")
+        REFERENCES[el.reference](scene)            # its own requirements (builder, loads, law)
+    if el.order == 2 and (scene.blocks or scene.remesh is not None or g.builder == "box" or g.dimension == 3):
+        raise ValueError("elasticity.order = 2 is for 2D elastic scenes (no plasticity, contact, thermal or remesh table)")
+    if el.plane != "axisymmetric":
+        if g.builder in AXI_BUILDERS:
+            raise ValueError(f"geometry.builder = {g.builder!r} makes an (r, z) section: set elasticity.plane = 'axisymmetric'")
+        return
+    if g.builder == "box" or g.dimension == 3:
+        raise ValueError("elasticity.plane = 'axisymmetric' needs a 2D (r, z) mesh")
+    contact = getattr(scene, "contact", None)
+    if contact is not None and contact.obstacle in ("ball", "cylinder"):
+        if contact.obstacle == "cylinder" or contact.center[0] != 0 or contact.normal[1] != "y":
+            raise ValueError("contact in an axisymmetric scene: a ball is a sphere only when centred on the axis "
+                             "(contact.center = [0, z]) and pressed along it (contact.normal = '+y' or '-y')")
+    thermal = getattr(scene, "thermal", None)
+    if thermal is not None and thermal.source == "manufactured":
+        raise ValueError("thermal.source = 'manufactured' is Cartesian; it has no axisymmetric form")
+
+
 def element(scene, dimension: int) -> str | None:
     """``P2`` for ``elasticity.order = 2`` (2D elastic scenes without remeshing), else None (the default P1)."""
     if scene.problem != "mechanics" or scene.elasticity.order == 1:

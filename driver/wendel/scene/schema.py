@@ -20,7 +20,7 @@ from pydantic import BaseModel, ConfigDict, Field, create_model, field_validator
 from .blocks import BLOCKS, PROBLEMS, choice, load_all
 from ..results.comparisons import COMPARISONS
 from ..meshes import BUILDERS
-from .axisymmetric import REFERENCES as AXI_REFERENCES
+from .axisymmetric import REFERENCES as AXI_REFERENCES, check as check_axisymmetric
 
 # Names a scene may use, mapped to the integer ids of edp/lib/loads.idp (never code).
 BODY_FORCES = {"none": 0, "constant": 1, "step8-discs": 2, "manufactured": 3}
@@ -261,6 +261,8 @@ class SceneBase(Strict):
                 block.check(getattr(self, name), self)
         if self.body_force.kind == "manufactured" and self.reference.analytic is None:
             raise ValueError("body_force.kind = \"manufactured\" needs reference.analytic")
+        if self.problem == "mechanics":
+            check_axisymmetric(self)       # elasticity.plane/order/reference against the other tables
         return self
 
     @property
