@@ -30,7 +30,7 @@ def _name_curves(gmsh, classify) -> list[str]:
     return sorted(groups)
 
 
-@register("axi_rectangle")
+@register("axi_rectangle", lambda r=(0.0, 1.0), **_: ["axis" if r[0] == 0 else "left", "right", "bottom", "top"])
 def axi_rectangle(path: Path, r=(0.0, 1.0), z=(0.0, 1.0), h=0.1, refine=None, structured=False) -> Built:
     """A rectangle [r0, r1] x [z0, z1] (m) of an (r, z) section: boundaries axis (r = 0; ``left`` when
     r0 > 0), right, bottom, top. ``structured=True``: a transfinite mesh (convergence studies)."""
@@ -60,7 +60,7 @@ def axi_rectangle(path: Path, r=(0.0, 1.0), z=(0.0, 1.0), h=0.1, refine=None, st
         return _write(gmsh, path, 2, names)
 
 
-@register("hollow_cylinder_section")
+@register("hollow_cylinder_section", ["inner", "outer", "bottom", "top"])
 def hollow_cylinder_section(path: Path, r_inner=1.0, r_outer=2.0, z=(0.0, 1.0), h=0.1, refine=None) -> Built:
     """The (r, z) section of a hollow cylinder (a bore of radius ``r_inner``): [r_inner, r_outer] x [z0, z1] (m);
     boundaries inner, outer, bottom, top (no axis)."""
@@ -83,7 +83,7 @@ def hollow_cylinder_section(path: Path, r_inner=1.0, r_outer=2.0, z=(0.0, 1.0), 
         return _write(gmsh, path, 2, _name_curves(gmsh, classify))
 
 
-@register("sphere_section")
+@register("sphere_section", lambda r_inner=0.0, half=False, **_: ["axis", "outer"] + (["inner"] if r_inner > 0 else []) + ([] if half else ["symmetry_y"]))
 def sphere_section(path: Path, r_inner=0.0, r_outer=1.0, h=0.05, refine=None, half=False) -> Built:
     """The (r, z) section of a sphere (``r_inner = 0``) or a thick-walled sphere (0 < r_inner < r_outer), m,
     centred at the origin: a quarter (z >= 0, boundary symmetry_y at z = 0) or with ``half=True`` the whole
@@ -112,7 +112,7 @@ def sphere_section(path: Path, r_inner=0.0, r_outer=1.0, h=0.05, refine=None, ha
         return _write(gmsh, path, 2, _name_curves(gmsh, classify))
 
 
-@register("notched_bar")
+@register("notched_bar", ["axis", "outer", "top", "symmetry_y"])
 def notched_bar(path: Path, radius=0.5, length=2.0, notch_radius=0.1, h=0.05, refine=None) -> Built:
     """Half of a round bar in (r, z): [0, radius] x [0, length / 2] (m), mirrored at z = 0 (boundary
     symmetry_y), with a circular notch of ``notch_radius`` (m) centred on the outer surface at z = 0 (the

@@ -52,6 +52,13 @@ AXI_BUILDERS = {"axi_rectangle", "sphere_section", "hollow_cylinder_section", "n
 def check(scene) -> None:
     """Rules of ``elasticity.plane/order/reference`` that join other tables, applied when the scene is read."""
     el, g = scene.elasticity, scene.geometry
+    if g.builder is not None:
+        from ..meshes.params import validate
+
+        try:
+            validate(g.builder, g.params)
+        except ValueError:
+            return                     # the geometry check names the bad keyword after this one
     if el.reference is not None:
         if el.plane != "axisymmetric":
             raise ValueError(f"elasticity.reference = {el.reference!r} needs elasticity.plane = 'axisymmetric'")
