@@ -132,6 +132,8 @@ def _indicator(scene: Scene, source: str) -> None:
         return
     valid = list(CELL_FIELDS) + [
         f for name in scene.blocks for f in BLOCKS[name].fields if f in BLOCK_CELL_FIELDS]
+    if scene.elasticity.plane == "axisymmetric":
+        valid.append("strain_hoop")            # the hoop strain of (r, z) models (edp/lib/mechanics.idp)
     if scene.remesh.indicator not in valid:
         raise SceneError(f"{source}: remesh.indicator: {scene.remesh.indicator!r} is not a cell field of this "
                          f"scene; valid: {', '.join(valid)} (or \"\" for a uniform size)")
