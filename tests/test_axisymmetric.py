@@ -230,3 +230,34 @@ def test_remeshed_plastic_sphere_keeps_its_state(tmp_path, quiet):
     fem = root / "fem"
     ut = np.array((sorted(fem.glob("inc-*"))[-1] / "u_total.node.txt").read_text().split()[1:], float).reshape(-1, 2)
     assert np.hypot(ut[:, 0], ut[:, 1]).max() == pytest.approx(ref["max_displacement"], rel=0.02)
+
+
+@pytest.mark.parametrize("builder, params, boundaries, area", [
+    ("axi_rectangle", {"r": [0.0, 1.0], "z": [0.0, 2.0], "h": 0.2}, {"axis", "right", "bottom", "top"}, 2.0),
+    ("hollow_cylinder_section", {"r_inner": 0.5, "r_outer": 1.0, "z": [0.0, 0.5], "h": 0.1},
+     {"inner", "outer", "bottom", "top"}, 0.25),
+    ("sphere_section", {"r_inner": 1.0, "r_outer": 2.0, "h": 0.1}, {"axis", "inner", "outer", "symmetry_y"},
+     np.pi * 3 / 4),
+    ("sphere_section", {"r_outer": 1.0, "h": 0.1, "half": True}, {"axis", "outer"}, np.pi / 2),
+    ("notched_bar", {"radius": 0.5, "length": 2.0, "notch_radius": 0.1, "h": 0.05},
+     {"axis", "outer", "top", "symmetry_y"}, 0.5 - np.pi * 0.01 / 4),
+])
+def test_section_builders_name_the_axis_and_mesh_the_section(tmp_path, builder, params, boundaries, area):
+    import meshio
+
+    from wendel.meshes import LABELS, build
+    from wendel.meshes.builders import BOUNDARIES
+
+    built = build(builder, tmp_path / "m.msh", **params)
+    assert set(built.boundaries) == boundaries == set(BOUNDARIES[builder](**params))
+    m = meshio.read(tmp_path / "m.msh", file_format="gmsh")
+    pts = m.points[:, :2]
+    tri = np.concatenate([b.data for b in m.cells if b.type == "triangle"])
+    a = pts[tri[:, 1]] - pts[tri[:, 0]]
+    b = pts[tri[:, 2]] - pts[tri[:, 0]]
+    assert np.abs(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]).sum() / 2 == pytest.approx(area, rel=2e-3)
+    assert pts[:, 0].min() >= -1e-12                                  # x = r >= 0
+    if "axis" in boundaries:                                          # the axis edges lie on r = 0
+        lines = np.concatenate([b.data for b in m.cells if b.type == "line"])
+        tags = np.concatenate([m.cell_data_dict["gmsh:physical"]["line"]])
+        assert np.abs(pts[lines[tags == LABELS["axis"]].ravel(), 0]).max() < 1e-12
