@@ -113,6 +113,9 @@ def check_size(scene: Scene, source: str) -> None:
                      and isinstance(v.default, (int, float, tuple)) and not isinstance(v.default, bool)}
             sizes.update({k: v for k, v in g.params.items() if k in sizes})
             used = ", ".join(f"{k} = {list(v) if isinstance(v, tuple) else v}" for k, v in sizes.items())
+            refine = g.params.get("refine")
+            if refine:
+                used += f", refined zone {', '.join(f'{k} = {v}' for k, v in refine.items())}"
             raise SceneError(
                 f"{source}: geometry.h: the mesh would have about {est:.2g} elements (estimated from h = {g.h:g} "
                 f"and the geometry: {used}), above numerics.max_elements = {n.max_elements:.3g}: use a larger h, "
@@ -135,8 +138,10 @@ def _indicator(scene: Scene, source: str) -> None:
     if scene.elasticity.plane == "axisymmetric":
         valid.append("strain_hoop")            # the hoop strain of (r, z) models (edp/lib/mechanics.idp)
     if scene.remesh.indicator not in valid:
+        writers = [f"[{name}]" for name, b in BLOCKS.items() if scene.remesh.indicator in b.fields]
+        why = f" (it is written by {' or '.join(writers)}, which this scene does not have)" if writers else ""
         raise SceneError(f"{source}: remesh.indicator: {scene.remesh.indicator!r} is not a cell field of this "
-                         f"scene; valid: {', '.join(valid)} (or \"\" for a uniform size)")
+                         f"scene{why}; valid: {', '.join(valid)} (or \"\" for a uniform size)")
 
 
 def load(path: str | Path, smoke: bool = False) -> Scene:
