@@ -88,14 +88,26 @@ def _failure_message(log: Path, rc: int) -> str:
     return f"exit code {rc}: {tail}"[:500]
 
 
+def _signal_name(rc: int) -> str:
+    try:
+        return signal.Signals(-rc).name
+    except ValueError:
+        return f"signal {-rc}"
+
+
 class Stopped(Exception):
     """The sweep is being stopped (Ctrl-C): the run was interrupted and stays resumable."""
 
 
-def execute(root: Path, key: str, on_start=None, stop: threading.Event | None = None) -> dict:
+def execute(root: Path, key: str, on_start=None, stop: threading.Event | None = None,
+            killed_is_failure: bool = True) -> dict:
     """Bring the run ``key`` of the sweep in ``root`` to an end: skip it when done, resume it when
     interrupted, start it afresh otherwise (failed attempts moved aside). Runs ``wendel run`` as a
     subprocess in its own process group; ``on_start(proc)`` is called with it (to stop it on Ctrl-C).
+
+    A run killed by a signal is failed, unless ``killed_is_failure`` is false (under SLURM: the scheduler
+    killed it, to requeue it or for good, and :func:`wendel.sweep.slurm.reconcile` reads which); it then
+    stays interrupted, to be resumed.
 
     Returns ``{"key", "status", "wall", "message", "action"}``; raises :class:`Stopped` when stopped.
     """
@@ -137,7 +149,10 @@ def execute(root: Path, key: str, on_start=None, stop: threading.Event | None = 
         return {"key": key, "status": DONE, "wall": wall, "message": "", "action": action}
     if stop is not None and stop.is_set():
         raise Stopped(key)
-    message = _failure_message(log, rc)
+    if rc < 0 and not killed_is_failure:
+        return {"key": key, "status": INTERRUPTED, "wall": wall, "message": f"killed by {_signal_name(rc)}",
+                "action": action}
+    message = f"killed by {_signal_name(rc)}" if rc < 0 else _failure_message(log, rc)
     mark_failed(folder, message, exit=rc, wall=wall, action=action)
     return {"key": key, "status": FAILED, "wall": wall, "message": message, "action": action}
 

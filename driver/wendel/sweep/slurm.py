@@ -28,7 +28,7 @@ class RunJob(submitit.helpers.Checkpointable):
     """One run of a sweep as a SLURM task; requeued on timeout or preemption (resumes from its checkpoint)."""
 
     def __call__(self, root: str, key: str) -> dict:
-        return execute(Path(root), key)
+        return execute(Path(root), key, killed_is_failure=False)
 
 
 def max_array_size() -> int:

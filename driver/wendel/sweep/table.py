@@ -95,6 +95,10 @@ def plots(root: Path, plan: dict, rows: list[dict], force: bool = False) -> list
     return written
 
 
+def _short(v) -> str:
+    return f"{v:.4g}" if isinstance(v, float) else str(v)
+
+
 def _safe(name: str) -> str:
     return "".join(c if c.isalnum() or c in "._-" else "-" for c in name)
 
@@ -144,11 +148,17 @@ def _error_vs_runtime(root: Path, done: list[dict], plt, params: list[str], quan
     if not names:
         return None
     fig, ax = plt.subplots(figsize=(5, 4))
+    others = [p for p in params if p != "geometry.h"]
+    groups: dict[tuple, list[dict]] = {}
+    for r in done:
+        groups.setdefault(tuple(r.get(p) for p in others), []).append(r)
     for n in names:
-        pts = sorted((_num(r.get("run_wall")) or _num(r.get("wall_time")), _num(r.get(n))) for r in done
-                     if _num(r.get(n)) and (_num(r.get("run_wall")) or _num(r.get("wall_time"))))
-        if pts:
-            ax.loglog([t for t, _ in pts], [e for _, e in pts], "o-", label=n)
+        for g, rows in groups.items():
+            pts = sorted((_num(r.get("run_wall")) or _num(r.get("wall_time")), _num(r.get(n))) for r in rows
+                         if _num(r.get(n)) and (_num(r.get("run_wall")) or _num(r.get("wall_time"))))
+            label = n + "".join(f", {p.rsplit('.', 1)[-1]}={_short(v)}" for p, v in zip(others, g))
+            if pts:
+                ax.loglog([t for t, _ in pts], [e for _, e in pts], "o-", label=label)
     ax.set_xlabel("run wall time [s]")
     ax.set_ylabel("error (difference: relative to the finest h)")
     ax.grid(alpha=0.3, which="both")
