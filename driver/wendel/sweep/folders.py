@@ -157,16 +157,68 @@ def execute(root: Path, key: str, on_start=None, stop: threading.Event | None = 
     return {"key": key, "status": FAILED, "wall": wall, "message": message, "action": action}
 
 
+def descendants(pid: int) -> list[int]:
+    """Every process below ``pid`` (from /proc), children first.
+
+    >>> child = subprocess.Popen(["sleep", "5"])
+    >>> child.pid in descendants(os.getpid()), child.kill(), child.wait()
+    (True, None, -9)
+    """
+    children: dict[int, list[int]] = {}
+    for d in Path("/proc").iterdir():
+        if d.name.isdigit():
+            try:
+                ppid = int((d / "stat").read_text().rsplit(")", 1)[1].split()[1])
+            except (OSError, IndexError, ValueError):
+                continue
+            children.setdefault(ppid, []).append(int(d.name))
+    out, todo = [], [pid]
+    while todo:
+        for c in children.get(todo.pop(), []):
+            out.append(c)
+            todo.append(c)
+    return out
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+        return True
+    except ProcessLookupError:
+        return False
+
+
 def stop_process(proc: subprocess.Popen, grace: float = 10.0) -> None:
-    """Stop a ``wendel run`` subprocess: SIGINT first (it stops FreeFEM and keeps its checkpoint), then
-    SIGTERM and SIGKILL to its process group."""
-    for sig, wait in ((signal.SIGINT, grace), (signal.SIGTERM, 3.0), (signal.SIGKILL, 3.0)):
+    """Stop a ``wendel run`` subprocess and everything it started, also the MPI launches in their own sessions:
+    SIGINT to its process group first (a run that handles it stops FreeFEM itself; the checkpoint stays),
+    then SIGTERM and SIGKILL to the process groups of every descendant seen before."""
+    tree = descendants(proc.pid)
+    groups = set()
+    for p in tree:
         try:
-            os.killpg(proc.pid, sig)
+            groups.add(os.getpgid(p))
         except ProcessLookupError:
+            pass
+    try:
+        os.killpg(proc.pid, signal.SIGINT)
+    except ProcessLookupError:
+        pass
+    try:
+        proc.wait(timeout=grace)
+    except subprocess.TimeoutExpired:
+        pass
+    for sig in (signal.SIGTERM, signal.SIGKILL):
+        left = [p for p in [proc.pid, *tree] if _alive(p)]
+        if not left:
             return
-        try:
-            proc.wait(timeout=wait)
-            return
-        except subprocess.TimeoutExpired:
-            continue
+        for g in groups | {proc.pid}:
+            try:
+                os.killpg(g, sig)
+            except ProcessLookupError:
+                pass
+        deadline = time.monotonic() + 5.0
+        while time.monotonic() < deadline and any(_alive(p) for p in left):
+            try:
+                proc.wait(timeout=0.1)
+            except subprocess.TimeoutExpired:
+                pass
