@@ -144,6 +144,10 @@ start() {
 
 stop() {
   local pids=()
+  if alive slurmctld; then          # jobs first: their slurmstepd outlive slurmd
+    squeue -h -o %A 2>/dev/null | sort -u | xargs -r scancel 2>/dev/null || true
+    for ((i = 0; i < 100; i++)); do [[ -z $(squeue -h -t R,CG,PD -o %A 2>/dev/null) ]] && break; sleep 0.1; done
+  fi
   for d in "${DAEMONS[@]}"; do
     if alive "$d"; then pids+=("$(cat "$(pidfile "$d")")"); fi
   done

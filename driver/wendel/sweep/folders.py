@@ -66,7 +66,7 @@ def mark_failed(folder: Path, message: str, **extra) -> None:
                                        "ended": time.strftime("%Y-%m-%dT%H:%M:%S%z")})
 
 
-def _move_aside(root: Path, key: str) -> None:
+def move_aside(root: Path, key: str) -> None:
     src = run_dir(root, key)
     (root / "failed").mkdir(exist_ok=True)
     n = 1
@@ -116,7 +116,7 @@ def execute(root: Path, key: str, on_start=None, stop: threading.Event | None = 
     if status == DONE:
         return {"key": key, "status": DONE, "wall": 0.0, "message": "", "action": "skipped"}
     if status in (FAILED, STALE):
-        _move_aside(root, key)
+        move_aside(root, key)
     if status == INTERRUPTED:
         action, args = "resumed", ["--resume", str(folder)]
     else:

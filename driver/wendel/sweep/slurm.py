@@ -18,7 +18,7 @@ from pathlib import Path
 
 import submitit
 
-from .folders import DONE, FAILED, execute, mark_failed, read_json, run_dir, state, write_json
+from .folders import DONE, FAILED, STALE, execute, mark_failed, move_aside, read_json, run_dir, state, write_json
 
 LIVE = {"PENDING", "RUNNING", "REQUEUED", "REQUEUE_HOLD", "REQUEUE_FED", "CONFIGURING", "COMPLETING", "SUSPENDED",
         "RESIZING", "SIGNALING", "STAGE_OUT", "RESV_DEL_HOLD", "STOPPED"}
@@ -49,6 +49,9 @@ def submit(root: Path, plan: dict, keys: list[str], opts, log=print) -> dict:
     if not keys:
         log("every run that is not done is queued or running already")
         return {}
+    for k in keys:                       # a failed attempt is moved aside now: the run is pending until its job runs
+        if state(run_dir(root, k))[0] in (FAILED, STALE):
+            move_aside(root, k)
     ranks = {e["key"]: e["ranks"] for e in plan["runs"]}
     executor = submitit.SlurmExecutor(folder=root / "slurm" / "%j", max_num_timeout=5)
     params = {"time": opts.time, "mem": opts.mem, "array_parallelism": opts.parallelism,
