@@ -126,19 +126,24 @@ def _cluster_unavailable() -> str | None:
     return None
 
 
-@pytest.fixture
-def slurm_cluster(tmp_path, monkeypatch):
-    """A single-node SLURM with accounting, started by scripts/slurm-local.sh and stopped after the test."""
+@pytest.fixture(scope="module")
+def slurm_cluster(tmp_path_factory):
+    """A single-node SLURM with accounting, started by scripts/slurm-local.sh and stopped after the tests."""
     reason = _cluster_unavailable()
     if reason:
         pytest.skip(reason)
-    d = tmp_path / "cluster"
+    d = tmp_path_factory.mktemp("cluster")
+    old = os.environ.get("SLURM_CONF")
     start = subprocess.run(["bash", str(CLUSTER), "start", str(d)], capture_output=True, text=True, timeout=120)
     try:
         assert start.returncode == 0, start.stderr
-        monkeypatch.setenv("SLURM_CONF", str(d / "etc" / "slurm.conf"))
+        os.environ["SLURM_CONF"] = str(d / "etc" / "slurm.conf")
         yield d
     finally:
+        if old is None:
+            os.environ.pop("SLURM_CONF", None)
+        else:
+            os.environ["SLURM_CONF"] = old
         subprocess.run(["bash", str(CLUSTER), "stop", str(d)], capture_output=True, text=True, timeout=120)
         left = subprocess.run(["pgrep", "-f", str(d)], capture_output=True, text=True).stdout.split()
         assert not left, f"daemons left running: {left}"
@@ -149,7 +154,7 @@ def test_sweep_through_slurm_with_a_failing_run_and_a_killed_job(tmp_path, slurm
     by scancel while running is reported failed (not waited for), and a re-run goes through the scheduler again."""
     sweep = sweep_file(tmp_path, '[zip]\n"material.E" = [1.0, 2.0, 3.0, 4.0]   # Pa\n'
                        '"numerics.timeout" = [600.0, 600.0, 0.01, 600.0]   # s\n'
-                       '"loading.steps" = [1, 100, 1, 1]   # 1\n[slurm]\ntime = 5\nmem = "500M"\nparallelism = 2\n')
+                       '"loading.steps" = [1, 40, 1, 1]   # 1\n[slurm]\ntime = 5\nmem = "500M"\nparallelism = 2\n')
     out = tmp_path / "out"
     keys = [r.key for r in load_sweep(sweep).runs]
     rep = run_sweep(sweep, out=out, executor="slurm", detach=True, quiet=True)
@@ -180,3 +185,33 @@ def test_sweep_through_slurm_with_a_failing_run_and_a_killed_job(tmp_path, slurm
     assert "2 failed before (re-run)" in rerun.stdout
     assert "3/4 done" in rerun.stdout, rerun.stdout + rerun.stderr      # the killed run now completes
     assert len(list((out / "failed").iterdir())) == 2                  # earlier attempts kept aside
+
+
+def test_a_preempted_slurm_run_is_requeued_and_resumes_from_its_checkpoint(tmp_path, slurm_cluster):
+    """SIGUSR2 (what SLURM sends before a time limit or a preemption) makes submitit requeue the job; the
+    requeued job resumes the run from its checkpoint (`wendel run --resume`) and completes it."""
+    sweep = sweep_file(tmp_path, '[zip]\n"loading.steps" = [60]   # 1\n[slurm]\ntime = 5\n')
+    out = tmp_path / "out"
+    key = load_sweep(sweep).runs[0].key
+    job = run_sweep(sweep, out=out, executor="slurm", detach=True, quiet=True)["jobs"][key]
+    deadline = time.time() + 60
+    while len(list((run_dir(out, key) / "fem").glob("inc-*/done"))) < 3:
+        assert time.time() < deadline, "the run did not start"
+        time.sleep(0.2)
+    subprocess.run(["scancel", "--signal=USR2", job], check=True)
+    deadline = time.time() + 30
+    while "BeginTime" not in subprocess.run(["squeue", "-h", "-j", job, "-o", "%r"], capture_output=True,
+                                             text=True).stdout:
+        assert time.time() < deadline, "the job was not requeued"
+        time.sleep(0.2)
+    subprocess.run(["scontrol", "update", f"jobid={job}", "StartTime=now"], check=True)   # not 2 min later
+    deadline = time.time() + 90
+    record_path = run_dir(out, key) / "sweep.json"       # written by the job after `wendel run` ended
+    while state(run_dir(out, key))[0] != DONE or not record_path.is_file():
+        assert time.time() < deadline, "the requeued run did not complete"
+        time.sleep(0.5)
+    record = json.loads(record_path.read_text())
+    assert record["action"] == "resumed"
+    assert json.loads((run_dir(out, key) / "summary.json").read_text())["increments"] == 60
+    log = (out / "logs" / f"{key}.log").read_text()
+    assert log.count("$ ") == 2 and "resuming" in log

@@ -117,6 +117,7 @@ def execute(root: Path, key: str, on_start=None, stop: threading.Event | None = 
         return {"key": key, "status": DONE, "wall": 0.0, "message": "", "action": "skipped"}
     if status in (FAILED, STALE):
         move_aside(root, key)
+    stop_leftovers(folder)
     if status == INTERRUPTED:
         action, args = "resumed", ["--resume", str(folder)]
     else:
@@ -178,6 +179,34 @@ def descendants(pid: int) -> list[int]:
             out.append(c)
             todo.append(c)
     return out
+
+
+def stop_leftovers(folder: Path) -> list[int]:
+    """Stop processes of an earlier attempt that still work in ``folder`` (on this host): an MPI launch runs
+    in its own session and outlives a ``wendel run`` killed by a signal where the scheduler tracks processes
+    by their parents (proctrack/linuxproc; proctrack/cgroup kills them). Returns their pids."""
+    mark = str(folder) + "/"
+    own = {os.getpid(), *descendants(os.getpid())}
+    found = []
+    for d in Path("/proc").iterdir():
+        if d.name.isdigit() and int(d.name) not in own:
+            try:
+                cmd = (d / "cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace")
+            except OSError:
+                continue
+            if mark in cmd or cmd.rstrip().endswith(str(folder)):
+                found.append(int(d.name))
+    for sig in (signal.SIGTERM, signal.SIGKILL):
+        left = [p for p in found if _alive(p)]
+        for p in left:
+            try:
+                os.kill(p, sig)
+            except ProcessLookupError:
+                pass
+        deadline = time.monotonic() + 5.0
+        while time.monotonic() < deadline and any(_alive(p) for p in left):
+            time.sleep(0.05)
+    return found
 
 
 def _alive(pid: int) -> bool:
