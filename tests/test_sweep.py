@@ -215,3 +215,11 @@ def test_a_preempted_slurm_run_is_requeued_and_resumes_from_its_checkpoint(tmp_p
     assert json.loads((run_dir(out, key) / "summary.json").read_text())["increments"] == 60
     log = (out / "logs" / f"{key}.log").read_text()
     assert log.count("$ ") == 2 and "resuming" in log
+
+
+def test_every_campaign_example_plans():
+    """workflows/campaigns/*.toml: each plans and validates every scene (no run)."""
+    examples = sorted((ROOT / "workflows" / "campaigns").glob("*.toml"))
+    assert len(examples) >= 3
+    for path in examples:
+        assert load_sweep(path).runs, path

@@ -5,7 +5,8 @@ failure, the wall time of ``wendel run`` as the sweep measured it (``run_wall``,
 fingerprints of summary.json (DoFs, increments, Newton iterations, wall time, errors, the numbers of the
 last increment). Plots: each chosen output against each parameter (``<output>.png``), a heat map per
 output when the sweep is a two-parameter grid (``heatmap-<output>.png``), and the error against run time
-(log-log) when the sweep is over ``geometry.h``. Plots are redrawn only when sweep.csv changed.
+(log-log, summary.json wall time, coarse to fine) when the sweep is over ``geometry.h``; time it with
+``--workers 1``, as concurrent runs slow each other. Plots are redrawn only when sweep.csv changed.
 """
 
 from __future__ import annotations
@@ -154,13 +155,15 @@ def _error_vs_runtime(root: Path, done: list[dict], plt, params: list[str], quan
         groups.setdefault(tuple(r.get(p) for p in others), []).append(r)
     for n in names:
         for g, rows in groups.items():
-            pts = sorted((_num(r.get("run_wall")) or _num(r.get("wall_time")), _num(r.get(n))) for r in rows
-                         if _num(r.get(n)) and (_num(r.get("run_wall")) or _num(r.get("wall_time"))))
+            pts = [(_num(r.get("wall_time")) or _num(r.get("run_wall")), _num(r.get(n)))
+                   for r in sorted(rows, key=lambda r: -r["geometry.h"])                 # coarse to fine
+                   if _num(r.get(n)) and (_num(r.get("wall_time")) or _num(r.get("run_wall")))]
             label = n + "".join(f", {p.rsplit('.', 1)[-1]}={_short(v)}" for p, v in zip(others, g))
             if pts:
                 ax.loglog([t for t, _ in pts], [e for _, e in pts], "o-", label=label)
-    ax.set_xlabel("run wall time [s]")
-    ax.set_ylabel("error (difference: relative to the finest h)")
+    ax.set_xlabel("run wall time (summary.json) [s]")
+    ax.set_ylabel("relative error" if not names[0].startswith("difference_")
+                  else f"{quantity}: relative difference to the finest h")
     ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize=8)
     fig.tight_layout()
