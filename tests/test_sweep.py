@@ -93,7 +93,7 @@ def test_local_grid_skips_done_runs_and_reruns_deleted_ones(tmp_path):
 
 def test_ctrl_c_leaves_a_resumable_sweep(tmp_path):
     """Ctrl-C stops every run (exit 130) keeping their checkpoints; the same command resumes them."""
-    sweep = sweep_file(tmp_path, '[grid]\n"material.E" = [1.0, 2.0]\n"loading.steps" = [40]   # 1\n')
+    sweep = sweep_file(tmp_path, '[grid]\n"material.E" = [1.0, 2.0]\n"loading.steps" = [20]   # 1\n')
     out = tmp_path / "out"
     proc = subprocess.Popen([sys.executable, "-m", "wendel.cli", "sweep", str(sweep), "--out", str(out),
                              "--workers", "2", "--quiet"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
@@ -113,7 +113,7 @@ def test_ctrl_c_leaves_a_resumable_sweep(tmp_path):
     assert subprocess.run(["pgrep", "-f", "--", f"FreeFem.*{out}"], capture_output=True).returncode == 1   # no FreeFEM left
     rep = run_sweep(sweep, out=out, workers=2, quiet=True)
     assert sorted(o["action"] for o in rep["outcomes"]) == ["resumed", "resumed"]
-    assert all(r["status"] == "done" and r["increments"] == 40 for r in rep["rows"])
+    assert all(r["status"] == "done" and r["increments"] == 20 for r in rep["rows"])
 
 
 def _cluster_unavailable() -> str | None:
@@ -190,7 +190,7 @@ def test_sweep_through_slurm_with_a_failing_run_and_a_killed_job(tmp_path, slurm
 def test_a_preempted_slurm_run_is_requeued_and_resumes_from_its_checkpoint(tmp_path, slurm_cluster):
     """SIGUSR2 (what SLURM sends before a time limit or a preemption) makes submitit requeue the job; the
     requeued job resumes the run from its checkpoint (`wendel run --resume`) and completes it."""
-    sweep = sweep_file(tmp_path, '[zip]\n"loading.steps" = [60]   # 1\n[slurm]\ntime = 5\n')
+    sweep = sweep_file(tmp_path, '[zip]\n"loading.steps" = [30]   # 1\n[slurm]\ntime = 5\n')
     out = tmp_path / "out"
     key = load_sweep(sweep).runs[0].key
     job = run_sweep(sweep, out=out, executor="slurm", detach=True, quiet=True)["jobs"][key]
@@ -199,20 +199,20 @@ def test_a_preempted_slurm_run_is_requeued_and_resumes_from_its_checkpoint(tmp_p
         assert time.time() < deadline, "the run did not start"
         time.sleep(0.2)
     subprocess.run(["scancel", "--signal=USR2", job], check=True)
-    deadline = time.time() + 30
+    deadline = time.time() + 60
     while "BeginTime" not in subprocess.run(["squeue", "-h", "-j", job, "-o", "%r"], capture_output=True,
                                              text=True).stdout:
         assert time.time() < deadline, "the job was not requeued"
         time.sleep(0.2)
     subprocess.run(["scontrol", "update", f"jobid={job}", "StartTime=now"], check=True)   # not 2 min later
-    deadline = time.time() + 90
+    deadline = time.time() + 180                         # generous: the test machine is shared
     record_path = run_dir(out, key) / "sweep.json"       # written by the job after `wendel run` ended
     while state(run_dir(out, key))[0] != DONE or not record_path.is_file():
         assert time.time() < deadline, "the requeued run did not complete"
         time.sleep(0.5)
     record = json.loads(record_path.read_text())
     assert record["action"] == "resumed"
-    assert json.loads((run_dir(out, key) / "summary.json").read_text())["increments"] == 60
+    assert json.loads((run_dir(out, key) / "summary.json").read_text())["increments"] == 30
     log = (out / "logs" / f"{key}.log").read_text()
     assert log.count("$ ") == 2 and "resuming" in log
 
