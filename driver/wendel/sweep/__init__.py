@@ -84,8 +84,15 @@ def run_sweep(sweep_path: Path, out: Path | None = None, executor: str = "local"
     if todo and executor == "local":
         from .local import default_workers, run_local
 
+        lock = _lock(root)
+        jobs = read_json(root / "slurm" / "jobs.json")
+        if jobs and any(k in jobs for k in todo):       # run here now: earlier SLURM jobs no longer speak for them
+            write_json(root / "slurm" / "jobs.json", {k: v for k, v in jobs.items() if k not in todo})
         n = workers or sweep.spec.workers or default_workers(max(r.ranks for r in sweep.runs))
-        outcomes = run_local(root, todo, n, skipped=counts[DONE], quiet=quiet)
+        try:
+            outcomes = run_local(root, todo, n, skipped=counts[DONE], quiet=quiet)
+        finally:
+            lock.close()
         report["outcomes"] = outcomes
         report["workers"] = n
     elif todo and executor == "slurm":
@@ -103,6 +110,19 @@ def run_sweep(sweep_path: Path, out: Path | None = None, executor: str = "local"
         report["rows"] = rows
         report["csv"] = csv_path
     return report
+
+
+def _lock(root: Path):
+    """One local sweep at a time in a folder (an exclusive lock on ``root/.lock``, released at exit)."""
+    import fcntl
+
+    f = open(root / ".lock", "w")
+    try:
+        fcntl.flock(f, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        f.close()
+        raise ValueError(f"{root}: another wendel sweep is running in this folder") from None
+    return f
 
 
 def collect_into(root: Path, plan: dict, force: bool = False):
