@@ -223,3 +223,17 @@ def test_every_campaign_example_plans():
     assert len(examples) >= 3
     for path in examples:
         assert load_sweep(path).runs, path
+
+
+def test_one_local_sweep_at_a_time_per_folder(tmp_path):
+    """A second `wendel sweep` on a folder in use is refused (exit 2) before it starts any run."""
+    import fcntl
+
+    sweep = sweep_file(tmp_path, '[grid]\n"material.E" = [1.0]   # Pa\n')
+    out = tmp_path / "out"
+    out.mkdir()
+    with open(out / ".lock", "w") as held:
+        fcntl.flock(held, fcntl.LOCK_EX)
+        second = wendel("sweep", sweep, "--out", out, "--quiet")
+    assert second.returncode == 2 and "another wendel sweep is running" in second.stderr
+    assert not any((out / "runs").iterdir())
