@@ -22,7 +22,7 @@ __all__ = ["prepare", "run_sweep", "status", "collect", "load_sweep", "sweep_roo
 
 def sweep_root(sweep_path: Path, out: Path | None = None) -> Path:
     """The sweep folder: ``out`` or results/sweeps/<sweep file stem>/."""
-    from ..run import RESULTS
+    from ..loop import RESULTS
 
     return Path(out).resolve() if out else RESULTS / "sweeps" / Path(sweep_path).stem
 

@@ -192,7 +192,7 @@ SMOKE_KEYS = {"h": "geometry.h", "steps": "loading.steps", "ranks": "numerics.ra
 
 @lru_cache(maxsize=1)
 def freefem_version() -> str:
-    from ..report import _freefem_version
+    from ..results.summary import _freefem_version
 
     return _freefem_version()
 
