@@ -22,9 +22,9 @@ __all__ = ["prepare", "run_sweep", "status", "collect", "load_sweep", "sweep_roo
 
 def sweep_root(sweep_path: Path, out: Path | None = None) -> Path:
     """The sweep folder: ``out`` or results/sweeps/<sweep file stem>/."""
-    from ..loop import RESULTS
+    from ..freefem import ROOT     # wendel.loop.RESULTS, without importing the loop (a re-run stays fast)
 
-    return Path(out).resolve() if out else RESULTS / "sweeps" / Path(sweep_path).stem
+    return Path(out).resolve() if out else ROOT / "results" / "sweeps" / Path(sweep_path).stem
 
 
 def prepare(sweep: Sweep, root: Path) -> dict:

@@ -24,6 +24,8 @@ import time
 from pathlib import Path
 
 DONE, FAILED, INTERRUPTED, PENDING, STALE = "done", "failed", "interrupted", "pending", "stale"
+EXIT_INTERRUPTED = 130
+"""``wendel run`` stopped by Ctrl-C or SIGTERM: FreeFEM stopped, the run resumable."""
 
 
 def run_dir(root: Path, key: str) -> Path:
@@ -105,7 +107,7 @@ def execute(root: Path, key: str, on_start=None, stop: threading.Event | None = 
     interrupted, start it afresh otherwise (failed attempts moved aside). Runs ``wendel run`` as a
     subprocess in its own process group; ``on_start(proc)`` is called with it (to stop it on Ctrl-C).
 
-    A run killed by a signal is failed, unless ``killed_is_failure`` is false (under SLURM: the scheduler
+    A run killed by a signal (or stopped by one: exit 130) is failed, unless ``killed_is_failure`` is false (under SLURM: the scheduler
     killed it, to requeue it or for good, and :func:`wendel.sweep.slurm.reconcile` reads which); it then
     stays interrupted, to be resumed.
 
@@ -150,10 +152,11 @@ def execute(root: Path, key: str, on_start=None, stop: threading.Event | None = 
         return {"key": key, "status": DONE, "wall": wall, "message": "", "action": action}
     if stop is not None and stop.is_set():
         raise Stopped(key)
-    if rc < 0 and not killed_is_failure:
-        return {"key": key, "status": INTERRUPTED, "wall": wall, "message": f"killed by {_signal_name(rc)}",
-                "action": action}
-    message = f"killed by {_signal_name(rc)}" if rc < 0 else _failure_message(log, rc)
+    killed = rc < 0 or rc == EXIT_INTERRUPTED
+    reason = "stopped by SIGINT or SIGTERM (exit 130)" if rc == EXIT_INTERRUPTED else f"killed by {_signal_name(rc)}"
+    if killed and not killed_is_failure:
+        return {"key": key, "status": INTERRUPTED, "wall": wall, "message": reason, "action": action}
+    message = reason if killed else _failure_message(log, rc)
     mark_failed(folder, message, exit=rc, wall=wall, action=action)
     return {"key": key, "status": FAILED, "wall": wall, "message": message, "action": action}
 
