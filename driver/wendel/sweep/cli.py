@@ -12,8 +12,9 @@ from pathlib import Path
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("target", nargs="+", metavar="SWEEP.toml | status TARGET | collect TARGET",
-                   help="run the sweep file; or report its status; or write sweep.csv and plots")
+    p.add_argument("target", nargs="+", metavar="ARG",
+                   help="SWEEP.toml: run the sweep; `status TARGET`: report it; `collect TARGET`: write sweep.csv "
+                   "and the plots (TARGET: the sweep file or its folder)")
     p.add_argument("--out", type=Path, help="sweep folder (default results/sweeps/<sweep file stem>)")
     p.add_argument("--executor", choices=("local", "slurm"), default="local")
     p.add_argument("--workers", type=int, help="local runs at a time (default cores / ranks per run)")
