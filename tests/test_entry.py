@@ -22,8 +22,9 @@ from wendel.scene import load
 from conftest import WORKFLOWS
 
 GUARDS = {"plasticity": "wendelPlasticityIdp", "contact": "wendelContactIdp", "thermal": "wendelThermalIdp",
-          "thermal-fields": "wendelThermalFieldsIdp", "elasticity": "wendelElasticityIdp"}
-MODULES = ("plasticity", "contact", "thermal", "thermal-fields")
+          "thermal-fields": "wendelThermalFieldsIdp", "elasticity": "wendelElasticityIdp",
+          "axisymmetric": "wendelAxisymmetricIdp", "axisymmetric-mechanics": "wendelAxisymmetricMechanicsIdp"}
+MODULES = ("plasticity", "contact", "thermal", "thermal-fields", "axisymmetric", "axisymmetric-mechanics")
 
 
 def compiled(tmp_path, scene_name: str) -> tuple[set[str], list[str], dict]:
