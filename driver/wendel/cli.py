@@ -1,4 +1,4 @@
-"""Command line: ``wendel run | study | check | bench``.
+"""Command line: ``wendel run | study | check | sweep | bench``.
 
 Exit codes: 0 done, 1 the run failed (FreeFEM error, no convergence, disk full), 2 bad input (scene,
 options), 130 interrupted (Ctrl-C or SIGTERM; the run resumes with ``wendel run --resume DIR``).
@@ -66,9 +66,13 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--update", type=Path, metavar="README", help="rewrite the table in this file instead")
 
     p = sub.add_parser("bench", help="benchmarks; results into results/bench/")
-    p.add_argument("names", nargs="*", help="benchmarks to run: axisymmetric, cylinder, elasticity, obstacle, remesh, step42, "
+    p.add_argument("names", nargs="*", help="benchmarks to run: axisymmetric, cylinder, elasticity, obstacle, remesh, step42, sweep, "
                    "thermal (the default: all of these), step42-dealii (only when named)")
     p.add_argument("--quick", action="store_true", help="small sizes only")
+
+    p = sub.add_parser("sweep", help="campaigns: a plan of runs, locally or on SLURM (see wendel.sweep)")
+    from .sweep.cli import add_arguments as sweep_arguments
+    sweep_arguments(p)
 
     args = parser.parse_args(argv)
     from .errors import DiskFull, Interrupted, StepCutError
@@ -101,6 +105,9 @@ def main(argv: list[str] | None = None) -> int:
             root = study(args.scene, levels=args.levels, smoke=args.smoke, ranks=args.np, out=args.out)
             print(f"study written to {root}")
             return 0
+        if args.command == "sweep":
+            from .sweep.cli import command as sweep_command
+            return sweep_command(args)
         if args.command == "keys":
             from .scene.schema import keys_table, update_readme
             if args.update:
