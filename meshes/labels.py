@@ -18,6 +18,8 @@ LABELS = {
     "outer": 8,     # outer surface of a hollow body
     "symmetry_x": 11,  # plane x = 0 of a symmetric model
     "symmetry_y": 12,  # plane y = 0 of a symmetric model
+    "free_surface": 21,  # orthogonal cutting: the uncut surface that becomes the chip's back
+    "machined": 22,      # orthogonal cutting: the machined surface behind the tool
     "domain": 100,  # the body itself
 }
 

@@ -1,4 +1,4 @@
-"""Command line: ``wendel run | study | check | bench``.
+"""Command line: ``wendel run | study | check | oxley | keys | bench``.
 
 Exit codes: 0 done, 1 the run failed (FreeFEM error, no convergence), 2 bad input (scene, options).
 """
@@ -35,6 +35,10 @@ def main(argv: list[str] | None = None) -> int:
     p = sub.add_parser("check", help="validate a scene file without running it")
     p.add_argument("scene", nargs="+")
 
+    p = sub.add_parser("oxley", help="the extended Oxley model's prediction of a cutting scene (milliseconds)")
+    p.add_argument("scene", help="scene file with a [cutting] table")
+    p.add_argument("--out", type=Path, help="folder of oxley.json and oxley.csv (default results/<scene>/oxley)")
+
     p = sub.add_parser("keys", help="print the scene keys (type, default, unit, range) as a Markdown table")
     p.add_argument("--update", type=Path, metavar="README", help="rewrite the table in this file instead")
 
@@ -65,6 +69,12 @@ def main(argv: list[str] | None = None) -> int:
             from .study import study
             root = study(args.scene, levels=args.levels, smoke=args.smoke, ranks=args.np, out=args.out)
             print(f"study written to {root}")
+            return 0
+        if args.command == "oxley":
+            from .cutting.scene import analytic, summary_lines
+            record, out = analytic(args.scene, args.out)
+            print("\n".join(summary_lines(record)))
+            print(f"written: {out / 'oxley.json'}, {out / 'oxley.csv'}")
             return 0
         if args.command == "keys":
             from .schema import keys_table, update_readme
