@@ -162,6 +162,8 @@ def test_cutting_scene_runs_the_analytic_model_and_refuses_fe(scene, tmp_path, c
     o = record["oxley"]
     assert o["Fc_N"] > o["Ft_N"] > 0 and o["chip_ratio_1"] > 1 and o["T_int_C"] > o["T_AB_C"] > 25
     assert (tmp_path / "ox" / "oxley.csv").read_text().count("\n") == 2
+    tool = np.loadtxt(tmp_path / "ox" / "tool.txt", skiprows=1)
+    assert tool.shape[1] == 2 and len(tool) == int((tmp_path / "ox" / "tool.txt").read_text().split()[0])
     assert "F_c = " in capsys.readouterr().out
     assert main(["run", str(WORKFLOWS / scene), "--smoke", "--out", str(tmp_path / "fe")]) == 2
     assert "wendel oxley" in capsys.readouterr().err

@@ -74,7 +74,7 @@ def main(argv: list[str] | None = None) -> int:
             from .cutting.scene import analytic, summary_lines
             record, out = analytic(args.scene, args.out)
             print("\n".join(summary_lines(record)))
-            print(f"written: {out / 'oxley.json'}, {out / 'oxley.csv'}")
+            print(f"written: {out / 'oxley.json'}, {out / 'oxley.csv'}, tool polygon {out / 'tool.txt'}")
             return 0
         if args.command == "keys":
             from .schema import keys_table, update_readme

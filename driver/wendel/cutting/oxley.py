@@ -255,7 +255,7 @@ def _fixed_point(G, x0: float, lo: float, hi: float) -> dict:
     for _ in range(100):
         g1 = G(x1)
         r1 = g1["T"] - x1
-        if abs(r1) < 1e-9 * x1:
+        if abs(r1) < 1e-12 * x1:
             return g1
         x2 = x1 - r1 * (x1 - x0) / (r1 - r0) if r1 != r0 else g1["T"]
         if not lo <= x2 <= hi:
@@ -279,6 +279,8 @@ class _Model:
         self._primary_cache: dict = {}
         self.last_phi: float | None = None    # warm starts of the root searches
         self.last_C0: float | None = None
+        self.last_T_AB: float | None = None   # warm starts of the temperature fixed points
+        self.last_T_prop: float | None = None
 
     def primary(self, phi: float, C0: float) -> dict:
         """Shear plane AB: strain, rate, temperature (fixed point), flow stress, forces."""
@@ -297,7 +299,8 @@ class _Model:
             dT_sz = (1.0 - beta) * k * l_ab * math.cos(a) / (th.rho * th.c(T) * cut.uncut * math.cos(phi - a))
             return dict(k=k, beta=beta, dT_sz=dT_sz, T=min(cut.T_work + self.opt.eta * dT_sz, mat.T_melt))
 
-        h = _fixed_point(heat, cut.T_work, cut.T_work, mat.T_melt)
+        h = _fixed_point(heat, self.last_T_AB or cut.T_work, cut.T_work, mat.T_melt)
+        self.last_T_AB = h["T"]
         T, k, beta, dT_sz = h["T"], h["k"], h["beta"], h["dT_sz"]
         fs = k * l_ab * cut.width
         out = dict(eps=eps, rate=rate, T_AB=T, k_AB=k, Fs=fs, beta=beta, dT_sz=dT_sz, n_eq=mat.n_eq(eps))
@@ -330,7 +333,8 @@ class _Model:
                 return dict(T_chip=T_chip, T_int=T_int,
                             T=min(self.T_chip_of(p["T_AB"], T_chip, T_int), mat.T_melt))
 
-            c = _fixed_point(chip, p["T_AB"], cut.T_work, mat.T_melt)
+            c = _fixed_point(chip, self.last_T_prop or p["T_AB"], cut.T_work, mat.T_melt)
+            self.last_T_prop = c["T"]
             T_chip, T_int = c["T_chip"], c["T_int"]
         eps_int = 2.0 * p["eps"] + 0.5 * h / (SQRT3 * delta * t2)
         rate_int = v_c / (SQRT3 * delta * t2)
@@ -408,7 +412,7 @@ def predict(material: JohnsonCook, thermal: ThermalProperties, cut: Cut, options
 
     lo, hi = options.delta_range
     # F_c(delta) is smooth with one minimum; a coarse scan keeps Brent inside a bracket with a solution
-    grid = [lo + (hi - lo) * i / 10 for i in range(11)]
+    grid = [lo + (hi - lo) * i / 6 for i in range(7)]
     vals = [cutting_force(d) for d in grid]
     i = min(range(len(grid)), key=vals.__getitem__)
     if not math.isfinite(vals[i]):
@@ -417,7 +421,7 @@ def predict(material: JohnsonCook, thermal: ThermalProperties, cut: Cut, options
                          f"{options.C0_range[1]:g}, delta {lo:g}-{hi:g} (V = {cut.speed:g} m/s, "
                          f"t1 = {cut.uncut:g} m, rake {math.degrees(cut.rake):g} deg)")
     a, b = grid[max(i - 1, 0)], grid[min(i + 1, len(grid) - 1)]
-    best = minimize_scalar(cutting_force, bounds=(a, b), method="bounded", options={"xatol": 1e-6})
+    best = minimize_scalar(cutting_force, bounds=(a, b), method="bounded", options={"xatol": 2e-5})
     delta = best.x if best.fun <= vals[i] else grid[i]
     s = model.solve_delta(delta)
     return Result(Fc=s["Fc"], Ft=s["Ft"], chip_thickness=s["t2"], phi=s["phi"], friction_angle=s["lam"],

@@ -21,6 +21,7 @@ import math
 from pathlib import Path
 
 from . import oxley
+from .tool import from_scene
 
 # The quantities written, with their units (JSON keys and CSV columns).
 COLUMNS = [
@@ -77,8 +78,9 @@ def friction_shear_angles(friction: float, rake_deg: float) -> dict:
 
 
 def analytic(scene_path: str | Path, out: Path | None = None) -> tuple[dict, Path]:
-    """Run the Oxley model on a scene file; write ``oxley.json`` and ``oxley.csv`` into ``out``
-    (default ``results/<scene>/oxley``); return the record and the folder."""
+    """Run the Oxley model on a scene file; write ``oxley.json`` and ``oxley.csv`` (and the scene's tool
+    polygon, ``tool.txt`` and ``tool.json``) into ``out`` (default ``results/<scene>/oxley``); return the
+    record and the folder."""
     from ..scene import load
 
     scene_path = Path(scene_path)
@@ -102,6 +104,9 @@ def analytic(scene_path: str | Path, out: Path | None = None) -> tuple[dict, Pat
         w = csv.DictWriter(fh, fieldnames=list(record["oxley"]))
         w.writeheader()
         w.writerow(record["oxley"])
+    tool = from_scene(c)           # the FE's tool, tip at the origin: vertices for the polygon tool
+    tool.write(out / "tool.txt")
+    (out / "tool.json").write_text(tool.to_json())
     return record, out
 
 

@@ -67,7 +67,7 @@ class ToolPolygon:
     def write(self, path: Path) -> Path:
         """Plain text for FreeFEM: the vertex count, then one ``x y`` row per vertex (m)."""
         path = Path(path)
-        path.write_text(f"{len(self.vertices)}\n" + "".join(f"{x!r} {y!r}\n" for x, y in self.vertices))
+        path.write_text(f"{len(self.vertices)}\n" + "".join(f"{float(x)!r} {float(y)!r}\n" for x, y in self.vertices))
         return path
 
     def to_json(self) -> str:
