@@ -79,4 +79,14 @@ def kienzle_bench(quick: bool, workdir: Path) -> list[dict]:
         for c in campaign.CATALOGUE[material]:
             out.append({"material": material, "source": c["source"], "kc11_N_per_mm2": c["kc11_N_per_mm2"],
                         "mc": c["mc"]})
+        # F_c at the scene's speed and width, rake 0 (the catalogues' neutral tool), against each catalogue law
+        v = scene.cutting.speed * 60
+        for h in (0.1, 0.2):
+            r = campaign.run(scene, [v], [h], [0.0])[0]
+            for c in campaign.CATALOGUE[material]:
+                fc_cat = r["b"] * 1e3 * c["kc11_N_per_mm2"] * h ** (1 - c["mc"])
+                out.append({"material": material, "source": f"F_c at V = {v:.0f} m/min, h = {h} mm, rake 0: "
+                            f"Oxley / {c['source'].split(':')[0]}", "speed_m_per_min": v, "rake_deg": 0.0,
+                            "h_min_mm": h, "h_max_mm": h, "Fc_oxley_N": r["Fc"], "Fc_catalogue_N": fc_cat,
+                            "Fc_difference": r["Fc"] / fc_cat - 1.0})
     return out
