@@ -48,6 +48,15 @@ def oxley_bench(quick: bool, workdir: Path) -> list[dict]:
         row.update({"phi_deg": math.degrees(r.phi), "C0": r.C0, "delta": r.delta, "evaluations": r.evaluations,
                     "ms": r.seconds * 1e3})
         rows.append(row)
+    # how flat F_c is in delta (the minimum-work condition) and how much T_int moves with it
+    best = rows[[r["properties"] for r in rows].index(opt.properties)]
+    model = oxley._Model(mat, th, cut, opt)
+    for f in (0.5, 0.75, 1.25, 1.5):
+        s = model.solve_delta(f * best["delta"])
+        rows.append({"case": f"delta = {f:g} x the optimum", "properties": opt.properties, "V_m_per_min": 200,
+                     "h_mm": 0.15, "Fc": s["Fc"], "Ft": s["Ft"], "chip_mm": s["t2"] * 1e3,
+                     "T_int_C": s["T_int"] - 273.15, "phi_deg": math.degrees(s["phi"]), "C0": s["C0"],
+                     "delta": s["delta"]})
     for v, h in ((200, 0.15), (200, 0.30), (300, 0.15), (300, 0.30)):
         mat, th, cut, opt = inputs(scene, speed=v / 60, uncut=h * 1e-3)
         r = oxley.predict(mat, th, cut, opt)
