@@ -10,11 +10,12 @@ right end a step of length ``pre_cut`` is already machined, so the tool starts a
     y = -depth +---------------------------------------+     bottom
               x = 0                                 x = length
 
-Elements have size ``h``, graded down to ``h_fine`` in a band along the tool path (the cut layer and a
-depth ``band`` below the machined level, where the primary shear zone and the machined surface form).
+Elements have size ``h``, graded down to ``fine * h`` in a band along the tool path (the cut layer and
+``band`` uncut chip thicknesses below the machined level, where the primary shear zone and the machined
+surface form); both are ratios, so the band follows ``h`` in studies and smoke runs.
 
 >>> import tempfile, pathlib
->>> b = orthogonal_cutting(pathlib.Path(tempfile.mkdtemp()) / "w.msh", h=1e-4, h_fine=5e-5)
+>>> b = orthogonal_cutting(pathlib.Path(tempfile.mkdtemp()) / "w.msh", h=1e-4, fine=0.5)
 >>> b.boundaries
 ['left', 'bottom', 'right', 'machined', 'free_surface']
 """
@@ -28,17 +29,16 @@ from .labels import LABELS
 
 
 @register("orthogonal-cutting")
-def orthogonal_cutting(path: Path, length=2e-3, depth=1e-3, uncut=0.15e-3, pre_cut=0.3e-3, band=None,
-                       h=1e-4, h_fine=None) -> Built:
-    """Workpiece of an orthogonal cut (all lengths in m): ``length`` along the cut, ``depth`` below the
+def orthogonal_cutting(path: Path, length=2e-3, depth=1e-3, uncut=0.15e-3, pre_cut=0.3e-3, band=2.0,
+                       fine=0.25, h=1e-4) -> Built:
+    """Workpiece of an orthogonal cut (lengths in m): ``length`` along the cut, ``depth`` below the
     machined level, the cut layer ``uncut`` thick, a machined step ``pre_cut`` long at the right end;
-    size ``h``, and ``h_fine`` (default h / 4) in the band from ``band`` (default 2 uncut) below the machined
-    level to the top of the cut layer."""
-    band = 2 * uncut if band is None else band
-    h_fine = h / 4 if h_fine is None else h_fine
-    if not (0 < pre_cut < length and 0 < uncut and 0 < depth and 0 < band <= depth and 0 < h_fine <= h):
-        raise ValueError("orthogonal-cutting needs 0 < pre_cut < length, uncut > 0, 0 < band <= depth and "
-                         "0 < h_fine <= h")
+    size ``h``, and ``fine * h`` in the band from ``band * uncut`` below the machined level to the top of
+    the cut layer."""
+    h_fine, band = fine * h, band * uncut
+    if not (0 < pre_cut < length and 0 < uncut and 0 < depth and 0 < band <= depth and 0 < fine <= 1):
+        raise ValueError("orthogonal-cutting needs 0 < pre_cut < length, uncut > 0, 0 < band * uncut <= depth "
+                         "and 0 < fine <= 1")
     x_step = length - pre_cut
     with _Session("orthogonal-cutting") as gmsh:
         geo = gmsh.model.geo

@@ -136,7 +136,7 @@ def test_tool_polygon_refuses_a_thin_wedge():
 def test_workpiece_mesh_labels_and_refinement_band(tmp_path):
     L, depth, uncut, pre = 2e-3, 1e-3, 0.15e-3, 0.3e-3
     built = build("orthogonal-cutting", tmp_path / "w.msh", length=L, depth=depth, uncut=uncut, pre_cut=pre,
-                  h=1e-4, h_fine=2.5e-5)
+                  h=1e-4, fine=0.25)
     m = meshio.read(tmp_path / "w.msh")
     lines = m.cells_dict["line"]
     tags = m.cell_data_dict["gmsh:physical"]["line"]
