@@ -69,6 +69,23 @@ def test_oxley_trends():
     assert fast.Fc < slow.Fc and fast.T_int > slow.T_int and fast.phi > slow.phi
 
 
+@pytest.mark.parametrize("scene,v,h,rake", [
+    ("cutting-aisi1045.toml", 20, 0.6, 20), ("cutting-aisi1045.toml", 50, 0.1, 10),
+    ("cutting-ti6al4v.toml", 20, 0.01, 30), ("cutting-ti6al4v.toml", 600, 1.0, 10),
+    ("cutting-ti6al4v.toml", 300, 0.3, 10)])
+def test_oxley_solves_or_refuses_clearly(scene, v, h, rake):
+    """Points at the edge of the model's domain (each once crashed inside scipy): a solution that meets
+    its conditions, or OxleyError with the reason; never another exception."""
+    args = inputs(load(WORKFLOWS / scene), speed=v / 60, uncut=h * 1e-3, rake=rake)
+    try:
+        r = oxley.predict(*args)
+    except oxley.OxleyError as exc:
+        assert "no Oxley solution" in str(exc) or "not reproduced" in str(exc)
+        return
+    s = oxley._Model(*args).state(r.phi, r.C0, r.delta)
+    assert abs(s["res_phi"]) < 1e-8 and abs(s["res_C0"]) < 1e-8 and r.Fc > 0
+
+
 def test_property_temperature_choice_is_a_registry():
     with pytest.raises(oxley.OxleyError, match="valid: shear-plane, chip, interface"):
         oxley.Options(properties="mean")

@@ -1,4 +1,4 @@
-"""Benchmarks of the orthogonal-cutting analytics: ``oxley`` and ``kienzle-oxley``.
+"""Benchmarks of the orthogonal-cutting analytics: ``oxley``, ``oxley-domain`` and ``kienzle-oxley``.
 
 ``oxley``: the extended Oxley model on the published AISI 1045 case (Lalwani et al. 2009) with each
 choice of where the secondary zone's k and c are taken, against the two published implementations'
@@ -64,6 +64,35 @@ def oxley_bench(quick: bool, workdir: Path) -> list[dict]:
                      "h_mm": h, "Fc": r.Fc, "Ft": r.Ft, "chip_mm": r.chip_thickness * 1e3,
                      "T_int_C": r.T_int - 273.15, "phi_deg": math.degrees(r.phi), "C0": r.C0, "delta": r.delta,
                      "evaluations": r.evaluations, "ms": r.seconds * 1e3})
+    return rows
+
+
+@register("oxley-domain")
+def oxley_domain(quick: bool, workdir: Path) -> list[dict]:
+    """Where the model has a solution: V 20-1000 m/min x h 0.01-1 mm x rake -20..30 deg for both scenes;
+    every point either solves (its residuals checked) or is refused with OxleyError."""
+    import itertools
+
+    from .cutting import oxley
+    from .cutting.scene import inputs
+    from .scene import load
+
+    speeds = [20, 100, 1000] if quick else [20, 50, 100, 300, 600, 1000]
+    uncuts = [0.01, 0.1, 1.0] if quick else [0.01, 0.02, 0.05, 0.1, 0.3, 0.6, 1.0]
+    rakes = [-20, 0, 30] if quick else [-20, -10, 0, 10, 20, 30]
+    rows = []
+    for scene_file in ("cutting-aisi1045.toml", "cutting-ti6al4v.toml"):
+        scene = load(WORKFLOWS / scene_file)
+        for v, h, rake in itertools.product(speeds, uncuts, rakes):
+            row = {"scene": scene_file, "V_m_per_min": v, "h_mm": h, "rake_deg": rake}
+            try:
+                r = oxley.predict(*inputs(scene, speed=v / 60, uncut=h * 1e-3, rake=rake))
+            except oxley.OxleyError:
+                rows.append({**row, "status": "refused"})
+                continue
+            s = oxley._Model(*inputs(scene, speed=v / 60, uncut=h * 1e-3, rake=rake)).state(r.phi, r.C0, r.delta)
+            rows.append({**row, "status": "solved", "Fc": r.Fc, "Ft": r.Ft, "max_residual":
+                         max(abs(s["res_phi"]), abs(s["res_C0"])), "ms": r.seconds * 1e3})
     return rows
 
 

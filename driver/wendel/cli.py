@@ -44,7 +44,7 @@ def main(argv: list[str] | None = None) -> int:
 
     p = sub.add_parser("bench", help="benchmarks; results into results/bench/")
     p.add_argument("names", nargs="*", help="benchmarks to run: cylinder, elasticity, kienzle-oxley, obstacle, "
-                   "oxley, remesh, step42, thermal (the default: all of these), step42-dealii (only when named)")
+                   "oxley, oxley-domain, remesh, step42, thermal (the default: all of these), step42-dealii (only when named)")
     p.add_argument("--quick", action="store_true", help="small sizes only")
 
     args = parser.parse_args(argv)

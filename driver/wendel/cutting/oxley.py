@@ -264,9 +264,18 @@ def _fixed_point(G, x0: float, lo: float, hi: float) -> dict:
     raise OxleyError("the temperature fixed point of the Oxley model did not converge in 100 steps")
 
 
-def _root(f, bracket: tuple[float, float]) -> float:
+def _root(f, bracket: tuple[float, float] | None) -> float | None:
+    """Brent's root in ``bracket``; None when the bracket does not hold a sign change (re-evaluated: with
+    warm starts a residual far from its own root is reproduced only to round-off) or meets a NaN."""
+    if bracket is None:
+        return None
     a, b = bracket
-    return a if a == b else brentq(f, a, b, xtol=1e-10, rtol=1e-12)
+    if a == b:
+        return a
+    try:
+        return brentq(f, a, b, xtol=1e-10, rtol=1e-12)
+    except ValueError:
+        return None
 
 
 class _Model:
@@ -322,8 +331,11 @@ class _Model:
         t2 = t1 * math.cos(phi - a) / math.sin(phi)
         v_c = cut.speed * math.sin(phi) / math.cos(phi - a)
         h = t1 * math.sin(theta) / (math.cos(lam) * math.sin(phi)) * (1.0 + cn / (3.0 * tan_theta))
+        if not (tan_theta > 0 and h > 0 and math.cos(lam) > 0):
+            # the resultant leaves the shear plane's range: no chip flow at these (phi, C0)
+            return dict(p, phi=phi, C0=C0, delta=delta, res_phi=math.nan, res_C0=math.nan, Fc=math.nan)
         T_int = T_chip = cut.T_work + p["dT_sz"]
-        if F > 0 and h > 0:
+        if F > 0:
             def chip(T_prop):
                 dT_c = F * math.sin(phi) / (th.rho * th.c(T_prop) * t1 * w * math.cos(phi - a))
                 x = th.thermal_number(T_prop, cut.speed, t1) * t2 / h
@@ -350,24 +362,32 @@ class _Model:
     def phi_for(self, C0: float, delta: float) -> float | None:
         """The shear angle where tau_int = k_int: the largest root in phi_range (None if there is none).
 
-        The first call scans down from phi_max in 1 deg steps; later calls start from the last root
-        (the solution moves little with C0 and delta) and step away from it until the sign changes."""
-        lo, hi = self.opt.phi_range
+        A call starts from the last root (the solution moves little with C0 and delta) and steps away from
+        it until the sign changes; the first call, or one where that fails, scans down from phi_max in
+        1 deg steps."""
         f = lambda phi: self.state(phi, C0, delta)["res_phi"]
+        root = None
         if self.last_phi is not None:
-            bracket = _bracket(f, self.last_phi, math.radians(0.25), lo, hi, falling=True)
-        else:
-            bracket, b, fb = None, hi, f(hi)
-            while b > lo and bracket is None:
-                a = max(b - math.radians(1.0), lo)
-                fa = f(a)
-                if fa > 0 >= fb:
-                    bracket = (a, b)
-                b, fb = a, fa
-        if bracket is None:
-            return None
-        self.last_phi = _root(f, bracket)
-        return self.last_phi
+            lo, hi = self.opt.phi_range
+            root = _root(f, _bracket(f, self.last_phi, math.radians(0.25), lo, hi, falling=True))
+        if root is None:
+            root = self._phi_scan(f)
+        if root is not None:
+            self.last_phi = root
+        return root
+
+    def _phi_scan(self, f) -> float | None:
+        lo, hi = self.opt.phi_range
+        b, fb = hi, f(hi)
+        while b > lo:
+            a = max(b - math.radians(1.0), lo)
+            fa = f(a)
+            if fa > 0 >= fb:           # NaN (no valid state) compares False: skipped
+                root = _root(f, (a, b))
+                if root is not None:
+                    return root
+            b, fb = a, fa
+        return None
 
     def C0_for(self, delta: float) -> float | None:
         """The strain-rate constant where the interface normal stress balances the one at the tool tip."""
@@ -376,20 +396,20 @@ class _Model:
             return math.nan if phi is None else self.state(phi, C0, delta)["res_C0"]
 
         lo, hi = self.opt.C0_range
-        bracket = None
+        root = None
         if self.last_C0 is not None:
-            bracket = _bracket(g, self.last_C0, 0.05, lo, hi, falling=None)
-        if bracket is None:
+            root = _root(g, _bracket(g, self.last_C0, 0.05, lo, hi, falling=None))
+        if root is None:
             grid = [lo + (hi - lo) * i / 8 for i in range(9)]
             vals = [g(c) for c in grid]
             for (c0, v0), (c1, v1) in zip(zip(grid, vals), zip(grid[1:], vals[1:])):
-                if v0 == v0 and v1 == v1 and v0 * v1 <= 0:
-                    bracket = (c0, c1)
-                    break
-        if bracket is None:
-            return None
-        self.last_C0 = _root(g, bracket)
-        return self.last_C0
+                if v0 * v1 <= 0:       # False with a NaN
+                    root = _root(g, (c0, c1))
+                    if root is not None:
+                        break
+        if root is not None:
+            self.last_C0 = root
+        return root
 
     def solve_delta(self, delta: float) -> dict | None:
         C0 = self.C0_for(delta)
@@ -408,7 +428,7 @@ def predict(material: JohnsonCook, thermal: ThermalProperties, cut: Cut, options
 
     def cutting_force(delta):
         s = model.solve_delta(delta)
-        return math.inf if s is None else s["Fc"]
+        return math.inf if s is None or not math.isfinite(s["Fc"]) else s["Fc"]
 
     lo, hi = options.delta_range
     # F_c(delta) is smooth with one minimum; a coarse scan keeps Brent inside a bracket with a solution
@@ -421,9 +441,16 @@ def predict(material: JohnsonCook, thermal: ThermalProperties, cut: Cut, options
                          f"{options.C0_range[1]:g}, delta {lo:g}-{hi:g} (V = {cut.speed:g} m/s, "
                          f"t1 = {cut.uncut:g} m, rake {math.degrees(cut.rake):g} deg)")
     a, b = grid[max(i - 1, 0)], grid[min(i + 1, len(grid) - 1)]
-    best = minimize_scalar(cutting_force, bounds=(a, b), method="bounded", options={"xatol": 2e-5})
+    penalty = 10.0 * max(v for v in vals if math.isfinite(v))       # Brent's parabolas need finite values
+    best = minimize_scalar(lambda d: min(cutting_force(d), penalty), bounds=(a, b), method="bounded",
+                           options={"xatol": 2e-5})
     delta = best.x if best.fun <= vals[i] else grid[i]
     s = model.solve_delta(delta)
+    if s is None or not math.isfinite(s["Fc"]):
+        delta, s = grid[i], model.solve_delta(grid[i])
+    if s is None or not math.isfinite(s["Fc"]):
+        raise OxleyError(f"the Oxley solution found at delta = {delta:g} was not reproduced (V = {cut.speed:g} m/s, "
+                         f"t1 = {cut.uncut:g} m, rake {math.degrees(cut.rake):g} deg)")
     return Result(Fc=s["Fc"], Ft=s["Ft"], chip_thickness=s["t2"], phi=s["phi"], friction_angle=s["lam"],
                   theta=s["theta"], C0=s["C0"], delta=delta, contact_length=s["h"], T_AB=s["T_AB"],
                   T_int=s["T_int"], T_chip=s["T_chip"], k_AB=s["k_AB"], k_int=s["k_int"], sigma_N=s["sigma_n"],
