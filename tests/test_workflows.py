@@ -4,8 +4,8 @@ import json
 
 import pytest
 
-from wendel.blocks.cutting import FE_READY
-from wendel.run import StepCutError, run
+from wendel.loop import StepCutError, run
+from wendel.scene.blocks.cutting import FE_READY
 
 from conftest import WORKFLOWS
 

@@ -25,6 +25,9 @@ Heat: Boothroyd's partition into the workpiece ``beta`` (0.5 - 0.35 lg(R_T tan p
 above 10), ``T_AB = T_w + eta dT_sz``; Oxley's chip-tool interface rise
 ``lg(dT_M / dT_c) = 0.06 - 0.195 delta sqrt(R_T t2 / h) + 0.5 lg(R_T t2 / h)``, ``T_int = T_w + dT_sz + psi dT_M``.
 
+The module is longer than 300 lines on purpose: the equations, their fixed points and the root searches
+are one published algorithm, read together.
+
 >>> r = predict(AISI1045_LALWANI, AISI1045_LALWANI_THERMAL, Cut(speed=200 / 60, uncut=0.15e-3,
 ...             width=1.6e-3, rake=math.radians(-7), T_work=298.15))
 >>> round(r.Fc), round(r.Ft), round(r.chip_thickness * 1e3, 2), round(r.T_int - 273.15)
