@@ -9,7 +9,7 @@ import meshio
 import numpy as np
 import pytest
 
-from wendel.bench.cutting import PUBLISHED_AISI1045, distance_to_range
+from wendel.bench.oxley import PUBLISHED_AISI1045, distance_to_range
 from wendel.cli import main
 from wendel.cutting import kienzle, oxley
 from wendel.cutting.scene import inputs

@@ -1,11 +1,11 @@
-"""Benchmarks of the orthogonal-cutting analytics: ``oxley``, ``oxley-domain`` and ``kienzle-oxley``.
+"""Benchmarks of the orthogonal-cutting analytics: ``oxley``, ``oxley-domain`` and ``oxley-kienzle``.
 
 ``oxley``: the extended Oxley model on the published AISI 1045 case (Lalwani et al. 2009) with each
 choice of where the secondary zone's k and c are taken, against the two published implementations'
 range, with the wall time of a solve; and the model at the four conditions of the NIST AISI 1045
 tests (Ivester et al. 2000: V = 200, 300 m/min; h = 0.15, 0.30 mm; rake -7 deg; b = 1.6 mm).
 
-``kienzle-oxley``: Oxley over speed x uncut chip thickness x rake for the AISI 1045 and Ti-6Al-4V
+``oxley-kienzle``: Oxley over speed x uncut chip thickness x rake for the AISI 1045 and Ti-6Al-4V
 scenes, Kienzle's k_c1.1 and m_c fitted per (speed, rake) and per rake, beside catalogue values.
 """
 
@@ -96,7 +96,7 @@ def oxley_domain(quick: bool, workdir: Path) -> list[dict]:
     return rows
 
 
-@register("kienzle-oxley")
+@register("oxley-kienzle")
 def kienzle_bench(quick: bool, workdir: Path) -> list[dict]:
     from ..cutting import campaign
     from ..scene import load
