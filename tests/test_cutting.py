@@ -11,7 +11,7 @@ import pytest
 
 from wendel.bench.oxley import PUBLISHED_AISI1045, distance_to_range
 from wendel.cli import main
-from wendel.cutting import kienzle, oxley
+from wendel.cutting import chip, kienzle, oxley
 from wendel.cutting.scene import inputs
 from wendel.cutting.tool import tool_polygon
 from wendel.meshes import LABELS, build
@@ -203,3 +203,37 @@ def test_bad_cutting_scenes_name_the_key(scene_file):
         with pytest.raises(SceneError) as exc:
             load(path)
         assert f"{path}: " in str(exc.value) and words in str(exc.value), str(exc.value)
+
+
+def test_shear_and_friction_angles_from_chip_and_forces_invert_oxley(steel):
+    """What an FE run or an experiment measures (t2, F_c, F_t) gives back Oxley's own phi and lambda."""
+    assert chip.shear_angle(CUT_1045.uncut, steel.chip_thickness, CUT_1045.rake) == pytest.approx(steel.phi, rel=1e-12)
+    assert chip.friction_angle(steel.Fc, steel.Ft, CUT_1045.rake) == pytest.approx(steel.friction_angle, rel=1e-12)
+
+
+def test_chip_thickness_of_a_chip_along_the_rake_face():
+    rake, t2 = math.radians(-7), 0.4155e-3
+    along, normal = np.array([math.sin(rake), math.cos(rake)]), np.array([-math.cos(rake), math.sin(rake)])
+    s = np.linspace(0.0, 2e-3, 81)
+    wobble = 0.01 * t2 * np.sin(40 * s / 2e-3)
+    pts = np.array([1e-3, 0.0]) + np.outer(s, along) + np.outer(t2 + wobble, normal)
+    median, spread = chip.chip_thickness(pts, [1e-3, 0.0], rake, band=(0.5e-3, 1.5e-3))
+    assert median == pytest.approx(t2, rel=0.01) and spread == pytest.approx(0.02 * t2, rel=0.05)
+    with pytest.raises(ValueError, match="no chip surface point"):
+        chip.chip_thickness(pts, [1e-3, 0.0], rake, band=(3e-3, 4e-3))
+
+
+def test_steady_state_of_a_settling_cut():
+    x = np.linspace(0.0, 2e-3, 201)                 # cut length [m]
+    fc = 575.0 * (1 - 0.5 * np.exp(-x / 0.2e-3)) * (1 + 0.004 * np.sin(x / 0.03e-3))
+    ratio = 2.77 * (1 - 0.3 * np.exp(-x / 0.15e-3))
+    st = chip.steady_state(x, {"Fc": fc, "chip_ratio": ratio}, length=0.5e-3, tol=0.02)
+    assert st is not None and st.end - st.start >= 0.5e-3 * (1 - 1e-9)
+    # settled: the exponential transients are below about 1 % at the start of the window
+    assert 0.5e-3 < st.start < 1.0e-3
+    assert st.values["Fc"] == pytest.approx(575.0, rel=0.01) and st.values["chip_ratio"] == pytest.approx(2.77, rel=0.01)
+    assert max(st.spreads.values()) <= 0.02
+    growing = chip.steady_state(x, {"Fc": 100 + 1e6 * x}, length=0.5e-3)
+    assert growing is None
+    with pytest.raises(ValueError, match="increasing"):
+        chip.steady_state(x[::-1], {"Fc": fc}, length=0.5e-3)
