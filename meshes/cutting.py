@@ -28,7 +28,7 @@ from .builders import Built, _Session, _write, register
 from .labels import LABELS
 
 
-@register("orthogonal-cutting")
+@register("orthogonal-cutting", ["left", "bottom", "right", "machined", "free_surface"])
 def orthogonal_cutting(path: Path, length=2e-3, depth=1e-3, uncut=0.15e-3, pre_cut=0.3e-3, band=2.0,
                        fine=0.25, h=1e-4) -> Built:
     """Workpiece of an orthogonal cut (lengths in m): ``length`` along the cut, ``depth`` below the
