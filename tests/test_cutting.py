@@ -178,6 +178,7 @@ def test_cutting_scene_runs_the_analytic_model_and_refuses_fe(scene, tmp_path, c
     record = json.loads((tmp_path / "ox" / "oxley.json").read_text())
     o = record["oxley"]
     assert o["Fc_N"] > o["Ft_N"] > 0 and o["chip_ratio_1"] > 1 and o["T_int_C"] > o["T_AB_C"] > 25
+    assert 0 < o["kinetic_1"] < o["inertia_1"] < 1e-3          # inertia negligible at these speeds
     assert (tmp_path / "ox" / "oxley.csv").read_text().count("\n") == 2
     tool = np.loadtxt(tmp_path / "ox" / "tool.txt", skiprows=1)
     assert tool.shape[1] == 2 and len(tool) == int((tmp_path / "ox" / "tool.txt").read_text().split()[0])

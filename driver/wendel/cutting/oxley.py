@@ -171,6 +171,8 @@ class Result:
     rake: float
     uncut: float
     width: float
+    inertia: float = 0.0      # rho V_s^2 / k_AB: momentum flux through the shear plane over its flow stress
+    kinetic: float = 0.0      # chip kinetic energy flux over the cutting power, rho V_c^2 b t1 / (2 F_c)
     evaluations: int = 0      # model evaluations of the solve
     seconds: float = 0.0      # wall time of the solve
 
@@ -459,6 +461,9 @@ def predict(material: JohnsonCook, thermal: ThermalProperties, cut: Cut, options
                   T_int=s["T_int"], T_chip=s["T_chip"], k_AB=s["k_AB"], k_int=s["k_int"], sigma_N=s["sigma_n"],
                   strain_AB=s["eps"], rate_AB=s["rate"], strain_int=s["eps_int"], rate_int=s["rate_int"],
                   beta=s["beta"], Fs=s["Fs"], F=s["F"], N=s["N"], rake=cut.rake, uncut=cut.uncut,
+                  inertia=thermal.rho * (cut.speed * math.cos(cut.rake) / math.cos(s["phi"] - cut.rake)) ** 2 / s["k_AB"],
+                  kinetic=0.5 * thermal.rho * (cut.speed * math.sin(s["phi"]) / math.cos(s["phi"] - cut.rake)) ** 2
+                  * cut.width * cut.uncut / s["Fc"],
                   width=cut.width, evaluations=model.evaluations, seconds=time.perf_counter() - t0)
 
 

@@ -32,7 +32,7 @@ COLUMNS = [
     ("delta", "1", 1.0), ("T_AB", "C", None), ("T_int", "C", None), ("T_chip", "C", None),
     ("k_AB", "MPa", 1e-6), ("k_int", "MPa", 1e-6), ("sigma_N", "MPa", 1e-6), ("strain_AB", "1", 1.0),
     ("rate_AB", "1/s", 1.0), ("strain_int", "1", 1.0), ("rate_int", "1/s", 1.0), ("beta", "1", 1.0),
-    ("seconds", "s", 1.0),
+    ("inertia", "1", 1.0), ("kinetic", "1", 1.0), ("seconds", "s", 1.0),
 ]
 
 
@@ -123,6 +123,8 @@ def summary_lines(record: dict) -> list[str]:
         f"(mu = {o['friction_coefficient_1']:.3f}), contact length {o['contact_length_mm']:.3f} mm",
         f"  T_AB = {o['T_AB_C']:.0f} C, T_int = {o['T_int_C']:.0f} C, mean chip {o['T_chip_C']:.0f} C; "
         f"C0 = {o['C0_1']:.3f}, delta = {o['delta_1']:.4f}; {o['seconds_s'] * 1e3:.0f} ms",
+        f"  inertia: rho V_s^2 / k_AB = {o['inertia_1']:.1e}, chip kinetic energy / cutting work = "
+        f"{o['kinetic_1']:.1e} ({'below 1 %: quasi-static steps are enough' if o['inertia_1'] < 0.01 else 'inertia matters'})",
         f"  shear angle from Oxley's friction angle: Merchant {o['phi_merchant_deg']:.1f} deg, Lee-Shaffer "
         f"{o['phi_lee_shaffer_deg']:.1f} deg",
         f"  from the scene's friction mu = {f['friction']:g} (lambda = {f['friction_angle_deg']:.1f} deg): "
