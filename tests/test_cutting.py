@@ -180,6 +180,10 @@ def test_cutting_scene_runs_the_analytic_model_and_refuses_fe(scene, tmp_path, c
     assert o["Fc_N"] > o["Ft_N"] > 0 and o["chip_ratio_1"] > 1 and o["T_int_C"] > o["T_AB_C"] > 25
     assert 0 < o["kinetic_1"] < o["inertia_1"] < 1e-3          # inertia negligible at these speeds
     assert (tmp_path / "ox" / "oxley.csv").read_text().count("\n") == 2
+    import matplotlib.image
+
+    img = matplotlib.image.imread(tmp_path / "ox" / "oxley.png")[..., :3].reshape(-1, 3)
+    assert len(np.unique(img.round(2), axis=0)) > 10          # a drawing, not a blank frame
     tool = np.loadtxt(tmp_path / "ox" / "tool.txt", skiprows=1)
     assert tool.shape[1] == 2 and len(tool) == int((tmp_path / "ox" / "tool.txt").read_text().split()[0])
     assert "F_c = " in capsys.readouterr().out

@@ -65,6 +65,7 @@ def main(argv: list[str] | None = None) -> int:
     p = sub.add_parser("oxley", help="the extended Oxley model's prediction of a cutting scene (milliseconds)")
     p.add_argument("scene", help="scene file with a [cutting] table")
     p.add_argument("--out", type=Path, help="folder of oxley.json and oxley.csv (default results/<scene>/oxley)")
+    p.add_argument("--no-png", action="store_true", help="no picture of the solution (oxley.png)")
 
     p = sub.add_parser("keys", help="print the scene keys (type, default, unit, range) as a Markdown table")
     p.add_argument("--update", type=Path, metavar="README", help="rewrite the table in this file instead")
@@ -108,7 +109,7 @@ def main(argv: list[str] | None = None) -> int:
             return 0
         if args.command == "oxley":
             from .cutting.scene import analytic, summary_lines
-            record, out = analytic(args.scene, args.out)
+            record, out = analytic(args.scene, args.out, picture=not args.no_png)
             print("\n".join(summary_lines(record)))
             print(f"written: {out / 'oxley.json'}, {out / 'oxley.csv'}, tool polygon {out / 'tool.txt'}")
             return 0

@@ -77,10 +77,10 @@ def friction_shear_angles(friction: float, rake_deg: float) -> dict:
             "phi_lee_shaffer_deg": math.degrees(oxley.lee_shaffer(lam, a))}
 
 
-def analytic(scene_path: str | Path, out: Path | None = None) -> tuple[dict, Path]:
-    """Run the Oxley model on a scene file; write ``oxley.json`` and ``oxley.csv`` (and the scene's tool
-    polygon, ``tool.txt`` and ``tool.json``) into ``out`` (default ``results/<scene>/oxley``); return the
-    record and the folder."""
+def analytic(scene_path: str | Path, out: Path | None = None, picture: bool = True) -> tuple[dict, Path]:
+    """Run the Oxley model on a scene file; write ``oxley.json`` and ``oxley.csv``, the scene's tool polygon
+    (``tool.txt``, ``tool.json``) and with ``picture`` a drawing of the solution (``oxley.png``) into ``out``
+    (default ``results/<scene>/oxley``); return the record and the folder."""
     from ..scene import load
 
     scene_path = Path(scene_path)
@@ -107,6 +107,10 @@ def analytic(scene_path: str | Path, out: Path | None = None) -> tuple[dict, Pat
     tool = from_scene(c)           # the FE's tool, tip at the origin: vertices for the polygon tool
     tool.write(out / "tool.txt")
     (out / "tool.json").write_text(tool.to_json())
+    if picture:
+        from .picture import oxley_picture
+
+        oxley_picture(result, tool, out / "oxley.png", title=f"{scene_path.stem}: extended Oxley model")
     return record, out
 
 
