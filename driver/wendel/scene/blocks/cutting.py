@@ -97,7 +97,9 @@ def check(block: Cutting, scene) -> None:
     g = scene.geometry
     if g.builder == "orthogonal-cutting":
         uncut = (g.model_extra or {}).get("uncut")
-        if uncut is not None and abs(float(uncut) - block.uncut_thickness) > 1e-9 * block.uncut_thickness:
+        if not isinstance(uncut, (int, float)) or isinstance(uncut, bool):
+            return      # absent, or not a number: the builder keywords' own validation names it
+        if abs(float(uncut) - block.uncut_thickness) > 1e-9 * block.uncut_thickness:
             raise ValueError(f"geometry.uncut ({float(uncut):g} m) and cutting.uncut_thickness "
                              f"({block.uncut_thickness:g} m) must be equal")
 
