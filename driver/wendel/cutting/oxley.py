@@ -9,17 +9,22 @@ Unknowns and the conditions that fix them (one pass of :func:`predict`):
 
 * shear angle ``phi``: the shear stress on the tool-chip interface from the forces, ``tau_int = F / (h w)``,
   equals the chip's flow shear stress there, ``k_int`` (Johnson-Cook at the interface's strain, strain
-  rate and temperature) -- solved by a root bracket scanned down from ``phi_max`` (the largest root,
-  where ``tau_int - k_int`` goes from + to -: a smaller root where the shear plane melts is spurious);
+  rate and temperature) -- Brent's root in a bracket stepped out from the last root, or scanned down from
+  ``phi_max`` (the largest root, where ``tau_int - k_int`` goes from + to -: a smaller root where the shear
+  plane melts is spurious);
 * strain-rate constant ``C0`` (shear plane length over primary zone thickness): the normal stress on the
   interface from the forces, ``N / (h w)``, equals the one at the tool tip from the stress field,
-  ``k_AB (1 + pi/2 - 2 alpha - 2 C0 n_eq)`` -- solved by Brent's root finder, not a grid;
+  ``k_AB (1 + pi/2 - 2 alpha - 2 C0 n_eq)`` -- Brent's root (bracket from the last root, else a 9-point
+  scan of ``C0_range``), not a grid;
 * ``delta`` (secondary zone thickness over chip thickness): the cutting force is a minimum
-  (Oxley's minimum-work hypothesis) -- bounded Brent minimisation.
+  (Oxley's minimum-work hypothesis) -- a 7-point scan of ``delta_range``, then bounded Brent minimisation.
 
-Inner fixed points: the shear-plane temperature ``T_AB`` (its flow stress sets the heat it makes), and,
-with ``properties = "chip"`` or ``"interface"``, the temperature at which the chip's conductivity and
-heat capacity are taken in the secondary zone (:data:`PROPERTY_TEMPERATURES`).
+Where a condition has no root in its range (low speeds, tiny h, large rakes) :class:`OxleyError` says so;
+a state where the resultant leaves the shear plane's range is a NaN residual that the searches step over.
+
+Inner fixed points (safeguarded secant, to 1e-12, warm-started): the shear-plane temperature ``T_AB`` (its
+flow stress sets the heat it makes), and, with ``properties = "chip"`` or ``"interface"``, the temperature at
+which the chip's conductivity and heat capacity are taken in the secondary zone (:data:`PROPERTY_TEMPERATURES`).
 
 Heat: Boothroyd's partition into the workpiece ``beta`` (0.5 - 0.35 lg(R_T tan phi), or 0.3 - 0.15 lg(...)
 above 10), ``T_AB = T_w + eta dT_sz``; Oxley's chip-tool interface rise
