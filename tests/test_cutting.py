@@ -242,3 +242,29 @@ def test_steady_state_of_a_settling_cut():
     assert growing is None
     with pytest.raises(ValueError, match="increasing"):
         chip.steady_state(x[::-1], {"Fc": fc}, length=0.5e-3)
+
+
+@pytest.mark.parametrize("scene", sorted(p.name for p in WORKFLOWS.glob("cutting-*.toml")))
+def test_cutting_scenes_survive_the_fuzzer(scene, tmp_path):
+    """tests/test_fuzz.py's mutations of a cutting scene, seeded by the scene alone: every refusal names the
+    file and the key, nothing escapes as a traceback (the shared fuzz test's single random stream gives
+    other scenes other mutations whenever a scene is added)."""
+    import random
+
+    import tomli_w
+    from test_fuzz import _check, mutations
+
+    text = (WORKFLOWS / scene).read_text()
+    bad, ran = [], 0
+    for i, (what, data, path, must_refuse) in enumerate(mutations(text, random.Random(f"cutting:{scene}"), 60)):
+        f = tmp_path / f"{i}.toml"
+        try:
+            f.write_text(tomli_w.dumps(data))
+        except (TypeError, ValueError):
+            continue
+        ran += 1
+        code, message = _check(f)
+        if code not in (0, 2) or (code == 2 and (str(f) not in message or str(path[-1]) not in message)) \
+                or (code == 0 and must_refuse):
+            bad.append(f"{what}: exit {code}: {message.strip()[:200]}")
+    assert ran >= 50 and not bad, bad
