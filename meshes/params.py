@@ -77,6 +77,9 @@ KNOWN: dict[str, Any] = {
     "radius": Length, "r_inner": Length, "r_outer": Length, "length": Length, "height": Length,
     "center": Point,
     "refine": Optional[Refine],
+    # orthogonal-cutting
+    "depth": Length, "uncut": Length, "pre_cut": Length, "band": Annotated[float, Field(gt=0)],
+    "fine": Annotated[float, Field(gt=0, le=1)],
 }
 
 
@@ -88,6 +91,11 @@ HELP = {
     "r_outer": "outer radius [m]", "length": "length of the body [m]", "height": "height of the body [m]",
     "center": "centre of the body [m]", "structured": "transfinite (structured) mesh, for convergence studies",
     "quarter": "model a quarter with symmetry planes", "refine": "a zone of finer elements (table below)",
+    "depth": "depth of the workpiece below the machined level [m]",
+    "uncut": "uncut chip thickness: the layer to be cut on top [m]",
+    "pre_cut": "length of the machined step the tool starts against [m]",
+    "band": "depth of the refined band below the machined level, in uncut thicknesses [1]",
+    "fine": "element size in the refined band as a fraction of h [1]",
 }
 
 
