@@ -118,6 +118,15 @@ def _execute(scene: Scene, files: RunFiles, state: State, progress) -> Path:
     dimension = json.loads(files.checkpoint.read_text())["dimension"]
     progress(f"wendel: {scene.description}")
     progress(f"  run folder {files.root}")
+    # the picture process warms up while FreeFEM solves (matplotlib for a plane body, else pyvista)
+    flat = dimension == 2 and scene.problem == "mechanics"
+    with pictures.Painter(flat) if scene.output.png else contextlib.nullcontext() as painter:
+        _solve_and_report(scene, files, state, dimension, progress, painter)
+    return files.root
+
+
+def _solve_and_report(scene: Scene, files: RunFiles, state: State, dimension: int, progress, painter) -> None:
+    """Solve, write summary.json, then the picture (the run's critical path waits for the render only)."""
     try:
         segment = state.segments[-1]
         after_reequilibration = len(state.segments) > 1 and state.last[0] == segment["first"]
@@ -132,16 +141,14 @@ def _execute(scene: Scene, files: RunFiles, state: State, progress) -> Path:
         t0 = time.perf_counter()
         inc, lf = state.last
         if scene.output.vtu:
-            pictures.picture(files.vtu / f"inc-{inc:04d}.vtu", files.root / "deformed.png", f"load factor {lf:g}",
-                             scene.output.warp)
+            painter.paint(files.vtu / f"inc-{inc:04d}.vtu", files.root / "deformed.png", f"load factor {lf:g}",
+                          scene.output.warp)
         else:            # no VTU series: the picture is made from a VTU of the last increment that is not kept
             with tempfile.TemporaryDirectory() as tmp:
                 _write_increment_vtu(files, state, dimension, inc, Path(tmp) / "last.vtu")
-                pictures.picture(Path(tmp) / "last.vtu", files.root / "deformed.png", f"load factor {lf:g}",
-                                 scene.output.warp)
-        state.post_seconds += time.perf_counter() - t0
-        summary.write_summary(files.root, scene, state, dimension)
-    return files.root
+                painter.paint(Path(tmp) / "last.vtu", files.root / "deformed.png", f"load factor {lf:g}",
+                              scene.output.warp)
+        summary.write_summary(files.root, scene, state, dimension, picture=time.perf_counter() - t0)
 
 
 def _write_increment_vtu(files: RunFiles, state: State, dimension: int, inc: int, path: Path) -> None:

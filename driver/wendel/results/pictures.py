@@ -1,4 +1,7 @@
-"""Pictures of a result: the deformed body, off-screen with pyvista (``deformed.png`` of a run)."""
+"""Pictures of a result: the deformed body (``deformed.png`` of a run), off-screen with pyvista
+(:func:`picture`), or with matplotlib for a plane body (:func:`flat_picture`: 0.6 s to import and draw
+where pyvista takes 3 s to import and open its first window). A run draws it in a :class:`Painter` process
+that starts with the run."""
 
 from __future__ import annotations
 
@@ -44,3 +47,138 @@ def picture(vtu: Path, png: Path, title: str, warp: float = 0.0, field: str | No
         plotter.view_isometric()
     plotter.screenshot(png)
     plotter.close()
+
+
+def flat_picture(vtu: Path, png: Path, title: str, warp: float = 0.0, field: str | None = None) -> None:
+    """A plane (2D) body with a vector displacement ``u``: the deformed triangles coloured by ``field`` (von Mises
+    by default), scaled as :func:`picture` does, drawn with matplotlib."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import meshio
+    from matplotlib.tri import Triangulation
+
+    m = meshio.read(vtu)
+    tri = np.concatenate([b.data for b in m.cells if b.type == "triangle"])
+    points = np.asarray(m.points)[:, :2]
+    u = np.asarray(m.point_data["u"])[:, :2]
+    size = max(np.ptp(points, axis=0))
+    umax = float(np.abs(u).max()) or 1.0
+    large = umax >= 0.05 * size or "u_total" in m.point_data
+    scale = warp or (1.0 if large else 0.1 * size / umax)
+    p = points + scale * u
+    field = field or ("vonMises" if "vonMises" in m.cell_data else None)
+    fig, ax = plt.subplots(figsize=(9, 7), dpi=100)
+    style = {"edgecolors": "k", "linewidth": 0.2} if len(tri) < 20000 else {}
+    if field:
+        values = np.concatenate([np.ravel(v) for v in m.cell_data[field]])
+        mesh = ax.tripcolor(Triangulation(p[:, 0], p[:, 1], tri), facecolors=values, cmap="viridis", **style)
+        fig.colorbar(mesh, ax=ax, label=field)
+    else:
+        ax.triplot(Triangulation(p[:, 0], p[:, 1], tri), color="k", linewidth=0.3)
+    ax.set_aspect("equal")
+    ax.set_title(f"{title} (displacement x{scale:.3g})", fontsize=10)
+    fig.savefig(png)
+    plt.close(fig)
+
+
+class Painter:
+    """A picture process started when a run starts: it imports pyvista and opens its off-screen window (about
+    3 s here, most of a smoke run's wall time when done at the end) or imports matplotlib (``flat``: 0.6 s)
+    while FreeFEM solves, so that the run ends with the render alone (0.2 s for a smoke mesh).
+
+    The process reads one request per line on its stdin and answers ``ok`` or the error on its stdout; it
+    ends when its stdin closes (also when the driver dies). ``with Painter() as p: p.paint(...)``.
+    """
+
+    def __init__(self, flat: bool = False):
+        """``flat``: a plane body with a vector displacement, drawn by :func:`flat_picture`."""
+        import subprocess
+        import sys
+
+        # its own session: Ctrl-C stops the driver, whose closing of stdin then ends this process
+        self.proc = subprocess.Popen([sys.executable, "-m", "wendel.results.pictures", "flat" if flat else "3d"],
+                                     stdin=subprocess.PIPE,
+                                     stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True,
+                                     start_new_session=True)
+
+    def paint(self, vtu: Path, png: Path, title: str, warp: float = 0.0) -> None:
+        """Render ``vtu`` into ``png`` (as :func:`picture`); raise RuntimeError if the process could not."""
+        import json
+
+        try:
+            self.proc.stdin.write(json.dumps({"vtu": str(vtu), "png": str(png), "title": title,
+                                              "warp": warp}) + "\n")
+            self.proc.stdin.flush()
+            answer = self.proc.stdout.readline().strip()
+        except OSError as exc:
+            answer = f"picture process ended: {exc}"
+        if answer != "ok":
+            raise RuntimeError(f"picture {png}: {answer or 'picture process ended'}")
+
+    def close(self) -> None:
+        """End the process (at once if it is still starting)."""
+        import contextlib
+        import subprocess
+
+        with contextlib.suppress(OSError):
+            self.proc.stdin.close()
+        try:
+            self.proc.wait(timeout=5)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+            self.proc.wait()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+
+def _serve() -> None:
+    """The picture process: warm up (import, one off-screen render), then one picture per request line."""
+    import json
+    import sys
+
+    if sys.argv[1:] == ["flat"]:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot  # noqa: F401 - warm-up
+        import meshio  # noqa: F401
+
+        draw = flat_picture
+    else:
+        _warm_up()
+        draw = picture
+    for line in sys.stdin:
+        try:
+            req = json.loads(line)
+            draw(Path(req["vtu"]), Path(req["png"]), req["title"], req["warp"])
+            answer = "ok"
+        except Exception as exc:        # noqa: BLE001 - reported to the driver, which raises it
+            answer = f"{type(exc).__name__}: {exc}".replace("\n", " ")
+        sys.stdout.write(answer + "\n")
+        sys.stdout.flush()
+
+
+def _warm_up() -> None:
+    """Import pyvista and render once off-screen (the first window costs ~1.8 s here)."""
+    os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+    import pyvista as pv
+
+    pv.OFF_SCREEN = True
+    try:                # a failure shows again at the real picture
+        warm = pv.Plotter(off_screen=True, window_size=(900, 700))
+        warm.add_mesh(pv.Sphere(), scalars=None)
+        warm.add_text("warm-up", font_size=10)
+        warm.screenshot(None, return_img=False)
+        warm.close()
+    except Exception:   # noqa: BLE001
+        pass
+
+
+if __name__ == "__main__":
+    _serve()
