@@ -18,6 +18,7 @@ from pathlib import Path
 from .. import freefem
 from ..errors import DiskFull, Interrupted, RunFolderError
 from ..meshes import build as build_mesh
+from ..remesh import batch as remesh_batch
 from ..remesh.step import finish_report, judge, maybe_remesh
 from ..results import pictures, summary, vtu
 from ..scene import load
@@ -174,8 +175,8 @@ def build(scene: Scene, files: RunFiles) -> tuple[float, int]:
 def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress) -> None:
     """Launch FreeFEM on the pending increments; cut failing steps; remesh when the mesh distorts.
 
-    Without remeshing one launch runs all pending increments (start-up paid once); with remeshing each
-    launch runs one increment so that the driver judges the mesh after every increment.
+    Without remeshing one launch runs all pending increments (start-up paid once); with remeshing one
+    launch runs a remeshing segment (FreeFEM ends it after a poor mesh, :mod:`wendel.remesh.batch`).
     """
     write_tables(scene, files, dimension)
     entry = entry_script(scene, dimension)
@@ -184,8 +185,8 @@ def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress)
         inc0 = state.last[0] + 1
         if scene.loading.adaptive and not state.reequilibrate:
             plan_step(scene, state)
-        one_by_one = scene.remesh is not None or scene.loading.adaptive
-        batch = state.pending[:1] if one_by_one else list(state.pending)
+        batch, stop_args = remesh_batch.plan(scene, state, dimension)
+        (files.fem / remesh_batch.STOP_FILE).unlink(missing_ok=True)
         loads = files.tables / "loads.txt"
         loads.write_text(f"{len(batch)}\n" + "".join(f"{lf!r}\n" for lf in batch))
         seg = state.segment(inc0)
@@ -198,7 +199,7 @@ def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress)
         failure, before, t0 = None, len(state.accepted), time.perf_counter()
         try:
             with watcher:
-                freefem.run(entry, switches + opts, files.fem, ranks=scene.numerics.ranks,
+                freefem.run(entry, switches + stop_args + opts, files.fem, ranks=scene.numerics.ranks,
                             timeout=scene.numerics.timeout, log=files.root / "freefem.log")
         except freefem.NewtonFailure as exc:
             failure = exc
@@ -206,7 +207,14 @@ def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress)
             accept(scene, files, state, dimension)
             state.launches.append({"wall": time.perf_counter() - t0, "increments": len(state.accepted) - before,
                                    "complete": failure is None})
-        if failure is None and len(state.accepted) - before < len(batch):
+        dropped = remesh_batch.roll_back(scene, files, state, inc0) if stop_args and state.accepted else []
+        if dropped:      # FreeFEM ran past a mesh the driver finds poor: solved again after the remesh
+            state.launches[-1]["increments"] -= len(dropped)
+            failure = None
+            _save_checkpoint(files, scene, state, dimension)
+            progress(f"  increments {dropped[0]}-{dropped[-1]} dropped: the mesh was poor before them")
+        stopped = bool(dropped) or remesh_batch.stopped_at(files.fem) == state.last[0]
+        if failure is None and len(state.accepted) - before < len(batch) and not stopped:
             if _disk_full(files.root):
                 raise DiskFull(files.root)
             raise freefem.FreeFemError(f"FreeFEM ended without committing increment {state.last[0] + 1} whole "

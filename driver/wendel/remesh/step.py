@@ -31,7 +31,8 @@ from pathlib import Path
 
 import numpy as np
 
-from . import mesher, quality, transfer
+from . import quality       # mesher (meshio, gmsh) and transfer (scipy) when a run remeshes: a run without
+                            # remeshing judges its mesh only and does not pay their imports
 from ..results import vtu
 
 SKIP_NODE = {"u", "u_total"}
@@ -81,6 +82,8 @@ def remesh_state(inc_dir: Path, mesh_old: Path, ubase_old: np.ndarray | None, di
     Writes ``mesh_new`` and, in ``state_new``, ``u.node.txt`` (zeros), ``ubase.txt``, ``eps0.txt`` and the
     module state files; returns the transfer report (without the re-equilibration residuals).
     """
+    from . import mesher, transfer
+
     t0 = time.perf_counter()
     X, cells = vtu.read_mesh(mesh_old, dimension)
     X = X[:, :dimension]
