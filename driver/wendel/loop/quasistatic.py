@@ -185,6 +185,7 @@ def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress)
         inc0 = state.last[0] + 1
         if scene.loading.adaptive and not state.reequilibrate:
             plan_step(scene, state)
+        was_reequilibration = state.reequilibrate
         batch, stop_args = remesh_batch.plan(scene, state, dimension)
         (files.fem / remesh_batch.STOP_FILE).unlink(missing_ok=True)
         loads = files.tables / "loads.txt"
@@ -214,6 +215,8 @@ def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress)
             _save_checkpoint(files, scene, state, dimension)
             progress(f"  increments {dropped[0]}-{dropped[-1]} dropped: the mesh was poor before them")
         stopped = bool(dropped) or remesh_batch.stopped_at(files.fem) == state.last[0]
+        if state.reequilibrate and state.accepted and state.last[0] >= state.segments[-1]["first"]:
+            _reequilibrated(files, state, progress)     # (the launch may go on past the re-equilibration)
         if failure is None and len(state.accepted) - before < len(batch) and not stopped:
             if _disk_full(files.root):
                 raise DiskFull(files.root)
@@ -223,11 +226,10 @@ def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress)
             cut_step(scene, files, state, failure, progress)
             _save_checkpoint(files, scene, state, dimension)
             continue
-        if scene.loading.adaptive and not state.reequilibrate:
+        if scene.loading.adaptive and not was_reequilibration:
             grow_step(scene, state, files)
-        if state.reequilibrate:
-            _reequilibrated(files, state, progress)
-        elif scene.remesh and state.pending:
+        if scene.remesh and state.pending and not (was_reequilibration
+                                                   and state.last[0] == state.segments[-1]["first"]):
             maybe_remesh(scene, files, state, dimension, progress)
         _save_checkpoint(files, scene, state, dimension)
 
@@ -236,7 +238,7 @@ def _reequilibrated(files: RunFiles, state: State, progress) -> None:
     """The increment on a new mesh is accepted: the remesh is complete (its report gets the residuals)."""
     state.reequilibrate = False
     rep = state.remeshes[-1]
-    finish_report(rep, files.fem / f"inc-{state.last[0]:04d}",
+    finish_report(rep, files.fem / f"inc-{state.segments[-1]['first']:04d}",
                   files.root / "remesh" / f"remesh-{len(state.remeshes)}.json")
     progress(f"  re-equilibrated on the new mesh: relative residual {rep['residual_after_transfer']:.2e}"
              f" -> {rep['residual_after_reequilibration']:.2e}")

@@ -36,18 +36,25 @@ def plan(scene, state, dimension: int) -> tuple[list[float], list[str]]:
     (3, ['-DREMESHSTOP=1', '-remesh_min_quality', '0.2'])
     >>> len(plan(scene, state, 3)[0])                               # 3D: one increment per launch
     1
+    >>> state.reequilibrate = True; plan(scene, state, 2)[1][-2:]   # no stop after the re-equilibration
+    ['-remesh_skip', '3']
     """
     r = scene.remesh
-    if scene.loading.adaptive or (r is not None and (state.reequilibrate or not inside_freefem(scene, dimension))):
-        return state.pending[:1], []
+    if scene.loading.adaptive:
+        return state.pending[:1], []            # the step is chosen after every increment
     if r is None or len(state.remeshes) >= r.max_remeshes:
         return list(state.pending), []          # no remeshing (any more): one launch for every increment
+    if not inside_freefem(scene, dimension):
+        return state.pending[:1], []            # the driver judges the mesh after every increment
     inc0 = state.last[0] + 1
     n = len(state.pending)
     forced = [a for a in r.at if a >= inc0]
     if forced:
         n = min(n, min(forced) - inc0 + 1)
-    return state.pending[:n], ["-DREMESHSTOP=1", "-remesh_min_quality", repr(float(r.min_quality))]
+    args = ["-DREMESHSTOP=1", "-remesh_min_quality", repr(float(r.min_quality))]
+    if state.reequilibrate:     # the re-equilibration on a new mesh is never judged (as before): no stop there
+        args += ["-remesh_skip", str(inc0)]
+    return state.pending[:n], args
 
 
 def stopped_at(fem) -> int | None:
@@ -64,7 +71,8 @@ def roll_back(scene, files, state, first: int) -> list[int]:
     r = scene.remesh
     if len(state.remeshes) >= r.max_remeshes:
         return []
-    mine = [i for i, _ in state.accepted if i >= first]
+    reeq = state.segments[-1]["first"] if len(state.segments) > 1 else None
+    mine = [i for i, _ in state.accepted if i >= first and i != reeq]
     poor = [i for i in mine if state.quality.get(i, {}).get("min_quality", 1.0) < r.min_quality
             or state.quality.get(i, {}).get("inverted", 0) > 0 or i in r.at]
     if not poor or poor[0] == state.last[0]:
