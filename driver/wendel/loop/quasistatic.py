@@ -208,13 +208,8 @@ def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress)
             accept(scene, files, state, dimension)
             state.launches.append({"wall": time.perf_counter() - t0, "increments": len(state.accepted) - before,
                                    "complete": failure is None})
-        dropped = remesh_batch.roll_back(scene, files, state, inc0) if stop_args and state.accepted else []
-        if dropped:      # FreeFEM ran past a mesh the driver finds poor: solved again after the remesh
-            state.launches[-1]["increments"] -= len(dropped)
-            failure = None
-            _save_checkpoint(files, scene, state, dimension)
-            progress(f"  increments {dropped[0]}-{dropped[-1]} dropped: the mesh was poor before them")
-        stopped = bool(dropped) or remesh_batch.stopped_at(files.fem) == state.last[0]
+        stopped = bool(stop_args) and remesh_batch.settle(scene, files, state, dimension, inc0, progress)
+        failure = None if stopped else failure
         if state.reequilibrate and state.accepted and state.last[0] >= state.segments[-1]["first"]:
             _reequilibrated(files, state, progress)     # (the launch may go on past the re-equilibration)
         if failure is None and len(state.accepted) - before < len(batch) and not stopped:

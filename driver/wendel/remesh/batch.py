@@ -65,6 +65,20 @@ def stopped_at(fem) -> int | None:
         return None
 
 
+def settle(scene, files, state, dimension: int, first: int, progress) -> bool:
+    """After a launch with stops from increment ``first`` on: roll back what ran past a mesh the driver finds
+    poor (what failed there too is solved again after the remesh); return whether the launch ended short on
+    purpose (stopped for remeshing, or rolled back)."""
+    dropped = roll_back(scene, files, state, first) if state.accepted else []
+    if dropped:
+        from ..loop.checkpoint import save
+
+        state.launches[-1]["increments"] -= len(dropped)
+        save(files, scene, state, dimension)
+        progress(f"  increments {dropped[0]}-{dropped[-1]} dropped: the mesh was poor before them")
+    return bool(dropped) or (bool(state.accepted) and stopped_at(files.fem) == state.last[0])
+
+
 def roll_back(scene, files, state, first: int) -> list[int]:
     """Drop the increments accepted after the first one of this launch (from ``first`` on) whose mesh the
     driver finds poor: their load factors are pending again. Returns the dropped increments."""
