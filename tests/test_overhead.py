@@ -45,10 +45,10 @@ def _not_blank(png) -> None:
     assert rgb.var() > 1e-3 and len(np.unique(rgb.round(2), axis=0)) > 20  # and a colour map
 
 
-@pytest.mark.parametrize("flat", [True, False])
-def test_painter_draws_a_picture(flat, tmp_path):
-    """The picture process (matplotlib for a plane body, pyvista for a solid) draws a PNG that is not blank,
-    and reports a bad request as an error instead of hanging."""
+@pytest.mark.parametrize("flat, renderer", [(True, "matplotlib"), (False, "matplotlib"), (False, "pyvista")])
+def test_painter_draws_a_picture(flat, renderer, tmp_path):
+    """The picture process (matplotlib, or pyvista for big meshes) draws a PNG of a plane body and of a solid
+    that is not blank, and reports a bad request as an error instead of hanging."""
     from wendel.results.pictures import Painter
 
     if flat:
@@ -62,7 +62,7 @@ def test_painter_draws_a_picture(flat, tmp_path):
     vm = np.arange(1.0, len(cells[0][1]) + 1)
     vtu = tmp_path / "a.vtu"
     meshio.write(vtu, meshio.Mesh(pts, cells, point_data={"u": u}, cell_data={"vonMises": [vm]}))
-    with Painter(flat) as painter:
+    with Painter(renderer) as painter:
         painter.paint(vtu, tmp_path / "a.png", "load factor 1")
         with pytest.raises(RuntimeError, match="picture"):
             painter.paint(tmp_path / "missing.vtu", tmp_path / "b.png", "x")

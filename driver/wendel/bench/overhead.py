@@ -113,3 +113,33 @@ def overhead(quick: bool, workdir: Path) -> list[dict]:
             print(f"  {row['scene']} ({row['tree']}): {row['process_wall']:.2f} s, outside "
                   f"{row.get('outside', float('nan')):.0%} {row.get('error', '')}", flush=True)
     return rows
+
+
+def side_by_side(before: list[dict], after: list[dict]) -> str:
+    """A Markdown table of two benchmark runs' rows (``before -> after`` per column), scene by scene.
+
+    >>> r = {"scene": "s", "size": "smoke", "launches": 2, "process_wall": 2.0, "wall": 1.0, "solve": 0.5,
+    ...      "outside": 0.5, "startup": 0.2, "mesh": 0.1, "freefem_output": 0.1, "driver_output": 0.05,
+    ...      "picture": 0.05}
+    >>> side_by_side([r], [dict(r, launches=1)]).splitlines()[2]
+    '| s | smoke | 2 → 1 | 2.0 → 2.0 | 1.0 → 1.0 | 0.50 → 0.50 | 50% → 50% | 0.20 → 0.20 | 0.10 → 0.10 | 0.10 → 0.10 | 0.05 → 0.05 | 0.05 → 0.05 |'
+    """
+    cols = [("launches", "launches", "{:d}"), ("process_wall", "process (s)", "{:.1f}"), ("wall", "run (s)", "{:.1f}"),
+            ("solve", "solve (s)", "{:.2f}"), ("outside", "outside solve", "{:.0%}"),
+            ("startup", "FreeFEM start-up (s)", "{:.2f}"), ("mesh", "meshing (s)", "{:.2f}"),
+            ("freefem_output", "FreeFEM output (s)", "{:.2f}"), ("driver_output", "driver output (s)", "{:.2f}"),
+            ("picture", "picture (s)", "{:.2f}")]
+    lines = ["| scene | size | " + " | ".join(c[1] for c in cols) + " |", "|---|---|" + "---|" * len(cols)]
+    old = {(r["scene"], r["size"]): r for r in before}
+    for r in after:
+        b = old.get((r["scene"], r["size"]), {})
+        cell = lambda k, f: " → ".join(f.format(x[k]) if isinstance(x.get(k), (int, float)) else "–" for x in (b, r))
+        lines.append(f"| {r['scene']} | {r['size']} | " + " | ".join(cell(k, f) for k, _, f in cols) + " |")
+    return "\n".join(lines)
+
+
+if __name__ == "__main__":      # python -m wendel.bench.overhead BEFORE.json AFTER.json
+    import sys as _sys
+
+    rows = [json.loads(Path(p).read_text())["rows"] for p in _sys.argv[1:3]]
+    print(side_by_side(*rows))

@@ -121,9 +121,8 @@ def _execute(scene: Scene, files: RunFiles, state: State, progress) -> Path:
     dimension = json.loads(files.checkpoint.read_text())["dimension"]
     progress(f"wendel: {scene.description}")
     progress(f"  run folder {files.root}")
-    # the picture process warms up while FreeFEM solves (matplotlib for a plane body, else pyvista)
-    flat = dimension == 2 and scene.problem == "mechanics"
-    with pictures.Painter(flat) if scene.output.png else contextlib.nullcontext() as painter:
+    # the picture process starts its renderer while FreeFEM solves
+    with pictures.Painter(pictures.renderer(files.mesh)) if scene.output.png else contextlib.nullcontext() as painter:
         _solve_and_report(scene, files, state, dimension, progress, painter)
     return files.root
 
