@@ -183,15 +183,16 @@ class Painter:
         if answer != "ok":
             raise RuntimeError(f"picture {png}: {answer or 'picture process ended'}")
 
-    def close(self) -> None:
-        """End the process (at once if it is still starting)."""
+    def close(self, at_once: bool = False) -> None:
+        """End the process: it ends by itself when its stdin closes (after its start if it is still
+        starting); killed after 5 s, or ``at_once`` (the run stopped short)."""
         import contextlib
         import subprocess
 
         with contextlib.suppress(OSError):
             self.proc.stdin.close()
         try:
-            self.proc.wait(timeout=5)
+            self.proc.wait(timeout=0 if at_once else 5)
         except subprocess.TimeoutExpired:
             self.proc.kill()
             self.proc.wait()
@@ -199,8 +200,8 @@ class Painter:
     def __enter__(self):
         return self
 
-    def __exit__(self, *exc):
-        self.close()
+    def __exit__(self, exc_type, *exc):
+        self.close(at_once=exc_type is not None)
 
 
 def _serve() -> None:
