@@ -22,8 +22,9 @@ from wendel.scene import load
 from conftest import WORKFLOWS
 
 GUARDS = {"plasticity": "wendelPlasticityIdp", "contact": "wendelContactIdp", "thermal": "wendelThermalIdp",
-          "thermal-fields": "wendelThermalFieldsIdp", "elasticity": "wendelElasticityIdp"}
-MODULES = ("plasticity", "contact", "thermal", "thermal-fields")
+          "thermal-fields": "wendelThermalFieldsIdp", "elasticity": "wendelElasticityIdp",
+          "remeshstop": "wendelRemeshStopIdp"}
+MODULES = ("plasticity", "contact", "thermal", "thermal-fields", "remeshstop")
 
 
 def compiled(tmp_path, scene_name: str) -> tuple[set[str], list[str], dict]:
