@@ -23,8 +23,9 @@ from conftest import WORKFLOWS
 
 GUARDS = {"plasticity": "wendelPlasticityIdp", "contact": "wendelContactIdp", "thermal": "wendelThermalIdp",
           "thermal-fields": "wendelThermalFieldsIdp", "elasticity": "wendelElasticityIdp",
-          "axisymmetric": "wendelAxisymmetricIdp", "axisymmetric-mechanics": "wendelAxisymmetricMechanicsIdp"}
-MODULES = ("plasticity", "contact", "thermal", "thermal-fields", "axisymmetric", "axisymmetric-mechanics")
+          "axisymmetric": "wendelAxisymmetricIdp", "axisymmetric-mechanics": "wendelAxisymmetricMechanicsIdp",
+          "remeshstop": "wendelRemeshStopIdp"}
+MODULES = ("plasticity", "contact", "thermal", "thermal-fields", "axisymmetric", "axisymmetric-mechanics", "remeshstop")
 
 
 def compiled(tmp_path, scene_name: str) -> tuple[set[str], list[str], dict]:

@@ -73,7 +73,7 @@ def main(argv: list[str] | None = None) -> int:
     p = sub.add_parser("bench", help="benchmarks; results into results/bench/")
     p.add_argument("names", nargs="*", help="benchmarks to run: axisymmetric, cylinder, elasticity, obstacle, "
                    "remesh, step42, sweep, thermal, the analytic cut's oxley, oxley-domain and oxley-kienzle "
-                   "(the default: all of these), step42-dealii (only when named)")
+                   "(the default: all of these), step42-dealii, overhead, gmsh3d (only when named)")
     p.add_argument("--quick", action="store_true", help="small sizes only")
 
     p = sub.add_parser("sweep", help="campaigns: a plan of runs, locally or on SLURM (see wendel.sweep)")

@@ -31,7 +31,8 @@ from pathlib import Path
 
 import numpy as np
 
-from . import mesher, quality, transfer
+from . import quality       # mesher (meshio, gmsh) and transfer (scipy) when a run remeshes: a run without
+                            # remeshing judges its mesh only and does not pay their imports
 from ..results import vtu
 
 SKIP_NODE = {"u", "u_total"}
@@ -92,6 +93,8 @@ def remesh_state(inc_dir: Path, mesh_old: Path, ubase_old: np.ndarray | None, di
     ``axisymmetric``: (r, z) meshes: recoveries and integrals with the volumes of revolution, the hoop strain
     carried in ``eps0``.
     """
+    from . import mesher, transfer
+
     t0 = time.perf_counter()
     X, cells = vtu.read_mesh(mesh_old, dimension)
     X = X[:, :dimension]
