@@ -24,7 +24,7 @@ from ..scene import load
 from ..scene.reading import check_size
 from ..scene.schema import Scene
 from .checkpoint import RunFiles, State, committed, load_state, save as _save_checkpoint
-from .guard import disk_full as _disk_full, guarded
+from .guard import disk_full as _disk_full, guarded, stop_leftovers
 from .launch import entry_script, macros, options, write_tables
 from .progress import _Progress
 from .steps import cut_step, grow_step, plan_step
@@ -284,6 +284,8 @@ def _restart(root: Path, progress) -> Path:
 
 def _resume(root: Path, progress=print) -> tuple[RunFiles, Scene, State]:
     files, scene, state, dimension = load_state(root)
+    if stop_leftovers(files.fem):
+        progress(f"  stopped a FreeFEM launch of {root} that outlived its driver")
     # An increment committed after the last checkpoint is taken as it is; a partial one is dropped.
     summary.truncate_history(files.root, state.last[0])
     accept(scene, files, state, dimension)
