@@ -18,6 +18,8 @@ LABELS = {
     "outer": 8,     # outer surface of a hollow body
     "symmetry_x": 11,  # plane x = 0 of a symmetric model
     "symmetry_y": 12,  # plane y = 0 of a symmetric model
+    "bore_wall": 21,   # cylindrical wall of a drilled bore (meshes/drilling.py)
+    "bore_bottom": 22,  # tip cone at the bottom of a drilled bore
     "domain": 100,  # the body itself
 }
 
