@@ -109,6 +109,9 @@ def run(scene_path: str | Path, smoke: bool = False, ranks: int | None = None, o
 
 def run_scene(scene: Scene, scene_path: Path, out: Path, smoke: bool = False, progress=print) -> Path:
     """Run an already validated scene (read from ``scene_path``) into the folder ``out``."""
+    if getattr(scene, "drilling", None) is not None:       # a process of removal steps: wendel.drilling
+        from . import drilling
+        return drilling.run(scene, scene_path, out, smoke, progress)
     files = RunFiles(Path(out).resolve())      # FreeFEM runs inside the run folder: paths must be absolute
     if files.root.is_dir() and any(files.root.iterdir()):
         # never mix a new run with the files of another (nor delete them): a new folder, or --resume

@@ -1,0 +1,499 @@
+"""The drilling process at workpiece scale: a remeshing drilling campaign (scene table ``[drilling]``).
+
+:func:`run` is the table of contents. For each process step (the drill advances by ``(depth -
+start_depth) / steps``, then dwells at the bottom):
+
+1. **remove**: the body with the bore up to the new tip depth is built anew from the geometry
+   (:mod:`wendel.meshes.drilling`: OCC boolean, graded mesh, boundaries re-tagged by geometry);
+2. **chips**: the heat content ``int rho c (T - T_0) dV`` of the removed slice (between the old and the
+   new bore) is integrated on the old mesh before removal (Gauss quadrature in (r, s, theta));
+3. **transfer**: temperature, total strain, plastic variables and the displacement reached go over
+   to the new mesh (:func:`wendel.remeshing.remesh_state` with the removal as its mesher, in the
+   reference configuration); the new mesh lies inside the old one, the report counts the new nodes
+   that needed extrapolation (outside the old mesh: chords of the old curved surfaces);
+4. **solve**: one FreeFEM increment of the thermo-mechanics over the step's time with the process
+   loads on the new surfaces: the heat flux ``eta_w P_c`` split between bore bottom and wall
+   (:class:`wendel.blocks.drilling.Drilling` has the Kienzle force model), the thrust as a traction on
+   the bore bottom, optional convection on the bore;
+5. **write**: VTU (the series runs across every remesh), probe temperatures, bore profile, energies.
+
+Then the drill is withdrawn and the part cools on the last mesh (one launch, ``cooling_steps``
+increments). Time runs as the load factor: ``t = lf * T_total``; the traction table holds
+``thrust / A / lf`` so that the traction FreeFEM scales by ``lf`` is the thrust of the step.
+
+Energy bookkeeping (J, every step, ``summary.json["drilling"]["energy"]``): heat put in by the flux =
+change of the thermal energy of the body + heat removed with the chips - convection (and the
+thermoelastic term) + the transfer defect (the heat the interpolation onto the new mesh created).
+What is not modelled: the chips as bodies (their heat leaves at once), tool wear, the chisel edge's
+forces, the torque as a traction (3D), frictional contact of the margins with the wall.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from . import freefem, output, quality, remesh, remeshing, report, transfer
+from . import run as runner
+from .meshes import LABELS
+from .meshes import drilling as geometry
+
+
+@dataclass
+class Step:
+    """One process step: its kind (drill, dwell), the tip depth at its end (m) and its end time (s)."""
+
+    kind: str
+    depth: float
+    time: float
+
+
+def plan(block) -> tuple[list[Step], list[float]]:
+    """The removal steps and the end times of the cooling increments."""
+    steps, t = [], 0.0
+    if block.depth > block.start_depth:
+        dt = block.advance_time() / block.steps
+        dd = (block.depth - block.start_depth) / block.steps
+        for k in range(1, block.steps + 1):
+            steps.append(Step("drill", block.start_depth + k * dd, k * dt))
+        t = steps[-1].time
+    if block.dwell > 0:
+        for k in range(1, block.dwell_steps + 1):
+            steps.append(Step("dwell", block.depth, t + k * block.dwell / block.dwell_steps))
+        t = steps[-1].time
+    cooling = [t + k * block.cooling / block.cooling_steps for k in range(1, block.cooling_steps + 1)] \
+        if block.cooling > 0 else []
+    return steps, cooling
+
+
+def run(scene, scene_path: Path, out: Path, smoke: bool = False, progress=print) -> Path:
+    """Run the drilling scene ``scene`` into the folder ``out``; return it."""
+    files = runner.RunFiles(Path(out).resolve())
+    if files.root.is_dir() and any(files.root.iterdir()):
+        raise ValueError(f"run folder {files.root} exists and is not empty: choose another --out")
+    files.root.mkdir(parents=True, exist_ok=True)
+    report.write_provenance(files.root, Path(scene_path), scene, smoke)
+    work = scene.model_copy(deep=True)
+    if smoke and scene.smoke.steps is not None:
+        work.drilling.steps = scene.smoke.steps             # smoke.steps: removal steps of a smoke run
+    scene = work.model_copy(deep=True)
+    block = scene.drilling
+    total = block.total_time()
+    work.thermal.duration = total
+    if getattr(work, "plasticity", None) is not None:
+        work.plasticity.load_time = total
+    plain = work.model_copy(update={"drilling": None})      # the mechanics + thermal entry script
+    entry = runner.entry_script(plain, 3)
+    steps, cooling = plan(block)
+    progress(f"wendel: {scene.description}")
+    progress(f"  run folder {files.root}")
+    progress(f"  P_c = {block.power():.1f} W (torque {block.drill_torque():.3g} N m), thrust "
+             f"{block.thrust_force():.1f} N, eta_w = {block.eta_w:g}; {len(steps)} removal steps, "
+             f"{len(cooling)} cooling increments, {total:.3g} s")
+    state = runner.State(pending=[])
+    state.segments = []
+    runner.write_tables(work, files, 3)
+    proc = Process(scene, work, files, state, entry, total, progress)
+    for k, step in enumerate(steps, 1):
+        proc.removal_step(k, step)
+    if cooling:
+        proc.cool(cooling)
+    summary = report.write_summary(files.root, work, state, 3)
+    proc.finish(summary)
+    return files.root
+
+
+class Process:
+    """The state of a drilling run between steps, and its records."""
+
+    def __init__(self, scene, work, files, state, entry, total, progress):
+        self.scene, self.work, self.files, self.state = scene, work, files, state
+        self.block, self.entry, self.total, self.progress = scene.drilling, entry, total, progress
+        th = work.thermal
+        self.rho_c = th.rho * th.c
+        self.T0 = th.T_initial if th.T_initial is not None else th.T_ref
+        self.g = scene.geometry
+        self.h_bore = self.block.h_bore or self.g.h / 3
+        self.rows: list[dict] = []           # one per step / cooling increment
+        self.probes: list[dict] = []
+        self.profiles: list[dict] = []
+        self.energy_prev = 0.0               # thermal energy at the end of the last step (J)
+        self.heat_boundary_prev = 0.0
+        self.heat_te_prev = 0.0
+        self.depth_prev = self.block.start_depth
+
+    # ---- the geometry of the workpiece
+    def build(self, depth: float, path: Path) -> dict:
+        params = {k: v for k, v in self.g.params.items() if k != "h"}
+        workpiece = "cylinder" if self.g.builder == "drilled-cylinder" else "block"
+        with remeshing._quiet_stdout():
+            geometry.drilled(path, workpiece, depth=depth, diameter=self.block.diameter,
+                             point_angle=self.block.point_angle, h=self.g.h, h_bore=self.h_bore,
+                             grade=self.block.grade, **params)
+        pts, _, cells, _, facets, tags = remesh.read_mesh(path)
+        return {"points": pts, "cells": cells, "facets": facets, "tags": tags}
+
+    def areas(self, mesh: dict) -> dict[str, float]:
+        p, f, tags = mesh["points"], mesh["facets"], mesh["tags"]
+        a = 0.5 * np.linalg.norm(np.cross(p[f[:, 1]] - p[f[:, 0]], p[f[:, 2]] - p[f[:, 0]]), axis=1)
+        return {n: float(a[tags == LABELS[n]].sum()) for n in geometry.BORE}
+
+    # ---- one removal step
+    def removal_step(self, k: int, step: Step) -> None:
+        files, state = self.files, self.state
+        t0 = time.perf_counter()
+        mesh_rel = f"meshes/step-{k:03d}.msh"
+        (files.root / "meshes").mkdir(exist_ok=True)
+        row = {"step": k, "kind": step.kind, "depth": step.depth, "time": step.time,
+               "dt": step.time - (self.rows[-1]["time"] if self.rows else 0.0)}
+        if not state.segments:
+            mesh = self.build(step.depth, files.root / mesh_rel)
+            seg = {"first": k, "mesh": mesh_rel, "ubase": None, "eps0": None}
+            row.update(chips_heat=0.0, energy_after_transfer=0.0, nodes_outside_old_mesh=0,
+                       remesh_seconds=time.perf_counter() - t0, transfer_seconds=0.0, chips_seconds=0.0)
+        else:
+            old_seg = state.segments[-1]
+            old_inc = files.fem / f"inc-{state.last[0]:04d}"
+            old_mesh = self.mesh
+            tc = time.perf_counter()
+            chips, outside = self.chips_heat(old_mesh, output.read_array(old_inc / "T.node.txt"),
+                                             self.depth_prev, step.depth)
+            row["chips_seconds"] = time.perf_counter() - tc
+            built = {}
+
+            def mesher(xd, mesh_old, mesh_new, h, size_indicator=None, h_min=None):
+                built["mesh"] = self.build(step.depth, Path(mesh_new))
+                q = quality.mesh_quality(built["mesh"]["points"], built["mesh"]["cells"])
+                return {"min_sicn": q["min"], "measure_old": float(remeshing.cell_volumes(xd, old_mesh["cells"]).sum()),
+                        "measure_new": float(remeshing.cell_volumes(built["mesh"]["points"], built["mesh"]["cells"]).sum())}
+
+            state_rel = f"remesh/state-{k:03d}"
+            ubase_old = output.read_array(files.root / old_seg["ubase"]) if old_seg["ubase"] else None
+            rep = remeshing.remesh_state(old_inc, files.root / old_seg["mesh"], ubase_old, 3, files.root / mesh_rel,
+                                         files.root / state_rel, self.g.h, self.h_bore, "", mesher=mesher,
+                                         deformed=False)
+            mesh = built["mesh"]
+            seg = {"first": k, "mesh": mesh_rel, "ubase": f"{state_rel}/ubase.txt", "eps0": f"{state_rel}/eps0.txt",
+                   "state": state_rel}
+            rep.update({"step": k, "depth_old": self.depth_prev, "depth_new": step.depth, "chips_heat": chips,
+                        "chips_points_outside": outside})
+            (files.root / "remesh").mkdir(exist_ok=True)
+            (files.root / "remesh" / f"remesh-{k:03d}.json").write_text(json.dumps(rep, indent=1))
+            state.remeshes.append(rep)
+            t_new = output.read_array(files.root / state_rel / "therm_T.node.txt")
+            row.update(chips_heat=chips, energy_after_transfer=self.energy(mesh, t_new),
+                       nodes_outside_old_mesh=rep["nodes_outside_old_mesh"], new_nodes=rep["new_nodes"],
+                       remesh_seconds=rep["remesh_seconds"], transfer_seconds=rep["transfer_seconds"])
+        state.segments.append(seg)
+        self.mesh = mesh
+        row["mesh_nodes"] = len(mesh["points"])
+        row["removed_volume"] = geometry.bore_volume(step.depth, self.block.diameter / 2, self.block.point_angle)
+        areas = self.areas(mesh)
+        wall_share = self.block.wall_fraction if areas["bore_wall"] > 0 else 0.0
+        q_in = self.block.eta_w * self.block.power()
+        fluxes = {"bore_wall": wall_share * q_in / areas["bore_wall"] if areas["bore_wall"] > 0 else 0.0,
+                  "bore_bottom": (1 - wall_share) * q_in / areas["bore_bottom"] if areas["bore_bottom"] > 0 else 0.0}
+        row["heat_in"] = row["dt"] * sum(fluxes[n] * areas[n] for n in fluxes)
+        row.update({f"area_{n}": a for n, a in areas.items()})
+        traction = -self.block.thrust_force() / areas["bore_bottom"] if areas["bore_bottom"] > 0 else 0.0
+        self.launch(k, [step.time], seg, fluxes, traction, restart=seg.get("state"))
+        row["launch_seconds"] = self.state.launches[-1]["wall"]
+        self.depth_prev = step.depth
+        self.close_rows([row])
+
+    def cool(self, times: list[float]) -> None:
+        """The drill is withdrawn: no flux, no thrust; the part cools on the last mesh."""
+        k = self.state.last[0] + 1
+        seg = self.state.segments[-1]
+        rows = [{"step": k + i, "kind": "cool", "depth": self.depth_prev, "time": t,
+                 "dt": t - (self.rows[-1]["time"] if i == 0 else times[i - 1]), "chips_heat": 0.0, "heat_in": 0.0,
+                 "nodes_outside_old_mesh": 0, "mesh_nodes": len(self.mesh["points"])} for i, t in enumerate(times)]
+        self.launch(k, times, seg, {"bore_wall": 0.0, "bore_bottom": 0.0}, 0.0,
+                    restart=str(self.files.fem / f"inc-{self.state.last[0]:04d}"))
+        self.close_rows(rows)
+
+    # ---- FreeFEM
+    def launch(self, inc0: int, times: list[float], seg: dict, fluxes: dict, traction: float, restart) -> None:
+        files, work, state = self.files, self.work, self.state
+        lfs = [t / self.total for t in times]
+        opts = runner.options(work, files, 3, seg)       # writes the scene's thermal table: replaced below
+        rows = [(LABELS[n], *b.row()) for n, b in work.thermal.boundary.items()]
+        for n, q in fluxes.items():
+            if q:
+                rows.append((LABELS[n], 1, q, 0.0))
+            if self.block.bore_h > 0:
+                rows.append((LABELS[n], 2, self.block.bore_h, self.block.bore_T_inf))
+        (files.tables / "thermal_bc.txt").write_text(
+            f"{len(rows)}\n" + "".join(f"{lab} {kind} {a!r} {b!r}\n" for lab, kind, a, b in rows))
+        trac = [line for line in (files.tables / "trac.txt").read_text().splitlines()[1:] if line.strip()]
+        trac = [r for r in trac if int(r.split()[0]) != LABELS["bore_bottom"]]
+        if traction and len(lfs) == 1:
+            trac.append(f"{LABELS['bore_bottom']} 0.0 0.0 {traction / lfs[0]!r} 0.0")
+        (files.tables / "trac.txt").write_text(f"{len(trac)}\n" + "".join(r + "\n" for r in trac))
+        loads = files.tables / "loads.txt"
+        loads.write_text(f"{len(lfs)}\n" + "".join(f"{lf!r}\n" for lf in lfs))
+        opts += ["-loads", str(loads), "-inc0", str(inc0), "-DWITHSTRESSFIELDS=1"]
+        if restart:
+            opts += ["-restart", str(files.root / restart)]
+        state.pending = list(lfs)
+        before, t0 = len(state.accepted), time.perf_counter()
+        try:
+            freefem.run(self.entry, opts, files.fem, ranks=work.numerics.ranks, timeout=work.numerics.timeout,
+                        log=files.root / "freefem.log")
+        finally:
+            runner.accept(work, files, state, 3)
+            state.launches.append({"wall": time.perf_counter() - t0, "increments": len(state.accepted) - before,
+                                   "complete": not state.pending})
+        if state.pending:
+            raise runner.StepCutError(f"increment {state.last[0] + 1} of the drilling run was not accepted; "
+                                      f"see {files.root / 'freefem.log'}")
+
+    # ---- bookkeeping after a launch
+    def close_rows(self, rows: list[dict]) -> None:
+        first = self.state.last[0] - len(rows) + 1
+        for i, row in enumerate(rows):
+            inc = first + i
+            d = self.files.fem / f"inc-{inc:04d}"
+            rec = json.loads((d / "record.json").read_text())
+            T = output.read_array(d / "T.node.txt")
+            energy = self.energy(self.mesh, T)
+            start = row.get("energy_after_transfer", self.energy_prev) if i == 0 else self.energy_prev
+            row["increment"] = inc
+            row["energy"] = energy
+            row["energy_change"] = energy - start
+            row["transfer_defect"] = (start - (self.energy_prev - row["chips_heat"])) if i == 0 else 0.0
+            row["heat_boundary"] = rec["heat_boundary"] - self.heat_boundary_prev
+            row["convection"] = row["heat_boundary"] - row["heat_in"]
+            row["heat_thermoelastic"] = rec["heat_thermoelastic"] - self.heat_te_prev
+            row["freefem_energy_change"] = rec["thermal_energy_change"]
+            row["max_temperature"] = rec["max_temperature"]
+            self.heat_boundary_prev, self.heat_te_prev = rec["heat_boundary"], rec["heat_thermoelastic"]
+            self.energy_prev = energy
+            self.rows.append(row)
+            self.record_probes(inc, row, T)
+            self.record_profile(inc, row, d)
+            self.progress(f"  step {row['step']} ({row['kind']}): depth {row['depth'] * 1e3:.3g} mm, t = {row['time']:.3g} s, "
+                          f"T_max {rec['max_temperature']:.1f} K, chips {row['chips_heat']:.3g} J, "
+                          f"{row.get('nodes_outside_old_mesh', 0)} nodes extrapolated")
+
+    def energy(self, mesh: dict, T: np.ndarray) -> float:
+        """Thermal energy of the body, int rho c (T - T_0) dV (J), exact for the P1 field."""
+        vol = remeshing.cell_volumes(mesh["points"], mesh["cells"])
+        return float(self.rho_c * vol @ transfer.nodes_to_cells(mesh["cells"], T - self.T0))
+
+    def chips_heat(self, mesh: dict, T: np.ndarray, d0: float, d1: float) -> tuple[float, int]:
+        """Heat content int rho c (T - T_0) dV of the slice the drill removes from d0 to d1 (J), on the old mesh."""
+        pts, w = removed_slice_quadrature(d0, d1, self.block.diameter / 2, self.block.point_angle,
+                                          self.g.params.get("height", 0.03), self.axis)
+        if len(pts) == 0:
+            return 0.0, 0
+        vals, outside = transfer.transfer_nodal(mesh["points"], mesh["cells"], T - self.T0, pts)
+        return float(self.rho_c * w @ vals), int(outside)
+
+    @property
+    def axis(self) -> tuple[float, float]:
+        return tuple(self.g.params.get("axis", (0.0, 0.0)))
+
+    def record_probes(self, inc: int, row: dict, T: np.ndarray) -> None:
+        if not self.block.probes:
+            return
+        names = list(self.block.probes)
+        pos = np.array([self.block.probes[n] for n in names], dtype=float)
+        inside = transfer.locate(self.mesh["points"], self.mesh["cells"], pos)[0] >= 0
+        vals, _ = transfer.transfer_nodal(self.mesh["points"], self.mesh["cells"], T, pos)
+        self.probes.append({"time": row["time"], **{n: float(v) if ok else float("nan")
+                                                     for n, v, ok in zip(names, vals, inside)}})
+
+    def record_profile(self, inc: int, row: dict, d: Path) -> None:
+        """Bore diameter error 2 u_r along the depth, and the stresses of the cells at the wall."""
+        prof = bore_profile(self.mesh, d, self.axis, self.g.params.get("height", 0.03), self.block.bore_bins)
+        if prof is not None:
+            self.profiles.append({"increment": inc, "time": row["time"], "kind": row["kind"], **prof})
+
+    # ---- summary, tables, pictures
+    def finish(self, summary: dict) -> None:
+        root = self.files.root
+        tables = root / "tables"
+        _write_csv(tables / "drilling-steps.csv", self.rows)
+        if self.probes:
+            _write_csv(tables / "probes.csv", self.probes)
+        rows = self.rows
+        heat_in = sum(r["heat_in"] for r in rows)
+        chips = sum(r["chips_heat"] for r in rows)
+        conv = sum(r["convection"] for r in rows)
+        te = sum(r["heat_thermoelastic"] for r in rows)
+        defect = sum(r["transfer_defect"] for r in rows)
+        d_energy = rows[-1]["energy"] if rows else 0.0
+        mismatch = heat_in + conv + te - d_energy - chips
+        scale = max(abs(heat_in), 1e-300)
+        shares = [(r.get("remesh_seconds", 0) + r.get("transfer_seconds", 0) + r.get("chips_seconds", 0))
+                  / max(r.get("remesh_seconds", 0) + r.get("transfer_seconds", 0) + r.get("chips_seconds", 0)
+                        + r.get("launch_seconds", 1e-300), 1e-300) for r in rows if r["kind"] != "cool"]
+        b = self.block
+        out = {
+            "process": {"power": b.power(), "torque": b.drill_torque(), "thrust": b.thrust_force(), "eta_w": b.eta_w,
+                        "wall_fraction": b.wall_fraction, "time_total": self.total,
+                        "removal_steps": sum(r["kind"] != "cool" for r in rows),
+                        "cooling_increments": sum(r["kind"] == "cool" for r in rows)},
+            "energy": {"heat_in": heat_in, "thermal_energy_change": d_energy, "chips_heat": chips,
+                       "convection": conv, "thermoelastic": te, "transfer_defect": defect,
+                       "balance_mismatch": mismatch, "balance_error": abs(mismatch) / scale},
+            "remesh": {"nodes_extrapolated": [r.get("nodes_outside_old_mesh", 0) for r in rows if r["kind"] != "cool"],
+                       "new_nodes": [r.get("new_nodes", r["mesh_nodes"]) for r in rows if r["kind"] != "cool"],
+                       "remesh_transfer_share": shares,
+                       "mean_remesh_transfer_share": float(np.mean(shares)) if shares else 0.0,
+                       "step_seconds": [r.get("remesh_seconds", 0) + r.get("transfer_seconds", 0)
+                                        + r.get("chips_seconds", 0) + r.get("launch_seconds", 0)
+                                        for r in rows if r["kind"] != "cool"]},
+            "probes_peak": {n: float(np.nanmax([p[n] for p in self.probes])) for n in b.probes} if self.probes else {},
+        }
+        if self.profiles:
+            last = self.profiles[-1]
+            drilled = [p for p in self.profiles if p["kind"] != "cool"]
+            out["bore"] = {"depth": last["depth"], "diameter_error_after": last["diameter_error"],
+                           "diameter_error_end_of_drilling": drilled[-1]["diameter_error"] if drilled else [],
+                           "hoop_stress_after": last["hoop_stress"], "axial_stress_after": last["axial_stress"]}
+        summary["drilling"] = out
+        (root / "summary.json").write_text(json.dumps(summary, indent=1))
+        (root / "drilling.json").write_text(json.dumps({**out, "steps": rows, "profiles": self.profiles}, indent=1))
+        if self.scene.output.png:
+            plots(root, rows, self.probes, self.profiles)
+        self.progress(f"  heat in {heat_in:.4g} J = stored {d_energy:.4g} + chips {chips:.4g} - convection {conv:.4g}"
+                      f" - thermoelastic {te:.3g}; mismatch {abs(mismatch) / scale:.2e} (transfer defect {defect:.3g} J)")
+        self.progress(f"  tables in {tables}, pictures and drilling.json in {root}")
+
+
+def removed_slice_quadrature(d0: float, d1: float, radius: float, point_angle: float, height: float,
+                             axis=(0.0, 0.0), n_r: int = 6, n_s: int = 6, n_theta: int = 48):
+    """Points (m) and weights (m^3) integrating over the slice B(d1) - B(d0) of the bore.
+
+    Gauss-Legendre in r on the pieces between the kinks of the profiles, in the depth s between the two
+    profiles, and the trapezoidal rule in theta (exact for trigonometric polynomials). The weights sum to
+    V(d1) - V(d0) to round-off:
+
+    >>> _, w = removed_slice_quadrature(0.002, 0.005, 0.003, 118.0, 0.02)
+    >>> bool(abs(w.sum() - (geometry.bore_volume(0.005, 0.003, 118.0) - geometry.bore_volume(0.002, 0.003, 118.0))) < 1e-18)
+    True
+    """
+    if d1 <= d0:
+        return np.zeros((0, 3)), np.zeros(0)
+    cot = 1 / math.tan(math.radians(point_angle) / 2)
+    kinks = sorted({0.0, radius, *(min(radius, d / cot) for d in (d0, d1) if d > 0)})
+    xr, wr = np.polynomial.legendre.leggauss(n_r)
+    xs, ws = np.polynomial.legendre.leggauss(n_s)
+    theta = 2 * math.pi * np.arange(n_theta) / n_theta
+    P, W = [], []
+    for a, b in zip(kinks[:-1], kinks[1:]):
+        r = 0.5 * (b - a) * xr + 0.5 * (a + b)
+        w_r = 0.5 * (b - a) * wr
+        s_lo, s_hi = np.maximum(0.0, d0 - r * cot), np.maximum(0.0, d1 - r * cot)
+        for ri, wri, lo, hi in zip(r, w_r, s_lo, s_hi):
+            if hi <= lo:
+                continue
+            s = 0.5 * (hi - lo) * xs + 0.5 * (hi + lo)
+            w_s = 0.5 * (hi - lo) * ws
+            for si, wsi in zip(s, w_s):
+                P.append(np.column_stack([axis[0] + ri * np.cos(theta), axis[1] + ri * np.sin(theta),
+                                          np.full(n_theta, height - si)]))
+                W.append(np.full(n_theta, wri * wsi * ri * 2 * math.pi / n_theta))
+    return np.vstack(P), np.concatenate(W)
+
+
+def bore_profile(mesh: dict, inc_dir: Path, axis, height: float, bins: int) -> dict | None:
+    """Along the depth: mean of 2 u_r at the bore-wall nodes (m) and of the hoop and axial stress (Pa) of
+    the cells touching the wall, in ``bins`` depth bins (NaN where a bin has no node)."""
+    p, f, tags, cells = mesh["points"], mesh["facets"], mesh["tags"], mesh["cells"]
+    wall = np.unique(f[tags == LABELS["bore_wall"]])
+    if len(wall) == 0:
+        return None
+    name = "u_total.node.txt" if (inc_dir / "u_total.node.txt").is_file() else "u.node.txt"
+    u = output.read_array(inc_dir / name).reshape(-1, 3)
+    x, y = p[wall, 0] - axis[0], p[wall, 1] - axis[1]
+    r = np.hypot(x, y)
+    ur = (u[wall, 0] * x + u[wall, 1] * y) / r
+    s = height - p[wall, 2]
+    edges = np.linspace(s.min(), s.max(), bins + 1)
+    mid = 0.5 * (edges[1:] + edges[:-1])
+    idx = np.clip(np.searchsorted(edges, s, side="right") - 1, 0, bins - 1)
+    d_err = [float(np.mean(2 * ur[idx == i])) if np.any(idx == i) else float("nan") for i in range(bins)]
+    hoop = axial = [float("nan")] * bins
+    if (inc_dir / "stress_xx.cell.txt").is_file():
+        on_wall = np.isin(cells, wall).sum(axis=1) >= 3          # cells with a face on the wall
+        c = p[cells[on_wall]].mean(axis=1)
+        cx, cy = c[:, 0] - axis[0], c[:, 1] - axis[1]
+        cr = np.hypot(cx, cy)
+        ct, st = cx / cr, cy / cr
+        S = {k: output.read_array(inc_dir / f"stress_{k}.cell.txt")[on_wall] for k in ("xx", "yy", "zz", "xy")}
+        s_tt = S["xx"] * st ** 2 + S["yy"] * ct ** 2 - 2 * S["xy"] * st * ct
+        cs = height - c[:, 2]
+        cidx = np.clip(np.searchsorted(edges, cs, side="right") - 1, 0, bins - 1)
+        hoop = [float(np.mean(s_tt[cidx == i])) if np.any(cidx == i) else float("nan") for i in range(bins)]
+        axial = [float(np.mean(S["zz"][cidx == i])) if np.any(cidx == i) else float("nan") for i in range(bins)]
+    return {"depth": mid.tolist(), "diameter_error": d_err, "hoop_stress": hoop, "axial_stress": axial}
+
+
+def _write_csv(path: Path, rows: list[dict]) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    keys = list(dict.fromkeys(k for r in rows for k in r))
+    with open(path, "w", newline="") as f:
+        w = csv.DictWriter(f, keys)
+        w.writeheader()
+        w.writerows(rows)
+
+
+def plots(root: Path, rows: list[dict], probes: list[dict], profiles: list[dict]) -> None:
+    """PNGs: probe temperatures, bore diameter error and wall stresses along the depth, energies."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    if probes:
+        fig, ax = plt.subplots(figsize=(6, 4))
+        t = [p["time"] for p in probes]
+        for n in [k for k in probes[0] if k != "time"]:
+            ax.plot(t, [p[n] for p in probes], marker=".", label=n)
+        ax.set_xlabel("time [s]")
+        ax.set_ylabel("temperature [K]")
+        ax.set_title("thermocouples")
+        ax.legend()
+        fig.tight_layout()
+        fig.savefig(root / "probes.png", dpi=100)
+        plt.close(fig)
+    if profiles:
+        fig, axes = plt.subplots(1, 2, figsize=(9, 4))
+        drilled = [p for p in profiles if p["kind"] != "cool"]
+        for p, label in ((drilled[-1] if drilled else None, "end of drilling"), (profiles[-1], "after cooling")):
+            if p is None:
+                continue
+            depth_mm = np.array(p["depth"]) * 1e3
+            axes[0].plot(np.array(p["diameter_error"]) * 1e6, depth_mm, marker="o", label=label)
+            axes[1].plot(np.array(p["hoop_stress"]) / 1e6, depth_mm, marker="o", label=f"hoop, {label}")
+            axes[1].plot(np.array(p["axial_stress"]) / 1e6, depth_mm, marker="x", label=f"axial, {label}")
+        axes[0].set_xlabel("diameter error 2 u_r [um]")
+        axes[1].set_xlabel("stress at the wall [MPa]")
+        for a in axes:
+            a.set_ylabel("depth below the entry face [mm]")
+            a.invert_yaxis()
+            a.legend(fontsize=7)
+        fig.tight_layout()
+        fig.savefig(root / "bore.png", dpi=100)
+        plt.close(fig)
+    fig, ax = plt.subplots(figsize=(6, 4))
+    t = [r["time"] for r in rows]
+    ax.plot(t, np.cumsum([r["heat_in"] for r in rows]), label="heat in (flux)")
+    ax.plot(t, [r["energy"] for r in rows], label="in the body")
+    ax.plot(t, np.cumsum([r["chips_heat"] for r in rows]), label="left with the chips")
+    ax.plot(t, -np.cumsum([r["convection"] for r in rows]), label="convection losses")
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("energy [J]")
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(root / "energy.png", dpi=100)
+    plt.close(fig)
