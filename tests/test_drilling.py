@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 
 import meshio
@@ -65,3 +66,98 @@ def test_removed_volume_axisymmetric_section(tmp_path, depth):
     labels = _facet_labels(m, "line")
     assert {LABELS[n] for n in ("top", "bottom", "outer", "symmetry_x")} <= labels
     assert (LABELS["bore_bottom"] in labels) == (depth > 0)
+
+
+# ---- the process loop (real gmsh + FreeFEM on tiny meshes)
+
+from wendel import output  # noqa: E402
+from wendel.run import run  # noqa: E402
+
+DRILL_SCENE = """
+description = "test: drilling a block"
+[geometry]
+builder = "drilled-block"
+x = [-0.008, 0.008]      # m
+y = [-0.008, 0.008]      # m
+height = 0.012           # m
+h = 0.005                # m
+[material]
+E = 110e9                # Pa
+nu = 0.26                # 1
+[boundary.bottom]
+ux = 0.0                 # m
+uy = 0.0                 # m
+uz = 0.0                 # m
+[thermal]
+k = 48.0                 # W/m/K
+rho = 7200.0             # kg/m^3
+c = 500.0                # J/kg/K
+alpha = 11.7e-6          # 1/K
+coupling = "staggered"
+[thermal.boundary.top]
+h = 10.0                 # W/m^2/K
+T_inf = 293.15           # K
+[drilling]
+diameter = 0.004         # m
+feed = 0.1e-3            # m
+speed = 2000.0           # 1/min
+force = "given"
+torque = 1.0             # N m
+eta_w = 0.3              # 1
+h_bore = 0.0015          # m
+{extra}
+[output]
+png = false
+"""
+
+
+def _drill(tmp_path, extra, name="d"):
+    scene = tmp_path / f"{name}.toml"
+    scene.write_text(DRILL_SCENE.format(extra=extra))
+    root = run(scene, out=tmp_path / name, progress=lambda *_: None)
+    return root, json.loads((root / "summary.json").read_text())["drilling"]
+
+
+def test_drill_that_does_not_advance_is_a_heated_disc(tmp_path):
+    """A drill dwelling at a fixed depth (steps that remove nothing keep the body and its mesh) gives the
+    temperature of the same flux on the bore bottom of the same mesh in one plain run; energy to 1e-6."""
+    dwell = 0.5
+    root, dr = _drill(tmp_path, f"depth = 0.003\nstart_depth = 0.003\ndwell = {dwell}\ndwell_steps = 2\n"
+                                f"wall_fraction = 0.0\nthrust = 0.0")
+    assert dr["energy"]["balance_error"] < 1e-6
+    assert dr["energy"]["chips_heat"] == 0.0
+    mesh = meshio.read(root / "meshes" / "step-001.msh")
+    tri, tags = mesh.cells_dict["triangle"], mesh.cell_data_dict["gmsh:physical"]["triangle"]
+    p = mesh.points
+    area = 0.5 * np.linalg.norm(np.cross(p[tri[:, 1]] - p[tri[:, 0]], p[tri[:, 2]] - p[tri[:, 0]]), axis=1)
+    q = 0.3 * 2 * math.pi * 2000.0 / 60 * 1.0 / area[tags == LABELS["bore_bottom"]].sum()
+    ref = DRILL_SCENE.split("[drilling]")[0].replace('builder = "drilled-block"',
+                                                     'builder = "drilled-block"\ndepth = 0.003\ndiameter = 0.004\n'
+                                                     'h_bore = 0.0015')
+    ref = ref.replace('coupling = "staggered"', f'coupling = "staggered"\nduration = {dwell}    # s')
+    ref += f"[thermal.boundary.bore_bottom]\nflux = {float(q)!r}    # W/m^2\n[loading]\nsteps = 2\n[output]\npng = false\n"
+    (tmp_path / "ref.toml").write_text(ref)
+    disc = run(tmp_path / "ref.toml", out=tmp_path / "ref", progress=lambda *_: None)
+    t_drill = output.read_array(root / "fem" / "inc-0002" / "T.node.txt")
+    t_disc = output.read_array(disc / "fem" / "inc-0002" / "T.node.txt")
+    assert t_drill.max() > 300.0
+    assert np.abs(t_drill - t_disc).max() <= 1e-8 * (t_disc.max() - 293.15)
+
+
+def test_energy_identity_with_removal(tmp_path):
+    """Heat in = heat in the body + heat left with the chips - convection, within 1 %, over a run of
+    three removal steps (remesh + conservative transfer each) and a cooling increment; the removed
+    volume of each step is the analytic one within the chord error."""
+    root, dr = _drill(tmp_path, "depth = 0.006\nsteps = 3\ncooling = 2.0\ncooling_steps = 1\nbore_h = 50.0\n"
+                                "thrust = 100.0")
+    e = dr["energy"]
+    assert e["chips_heat"] > 0.02 * e["heat_in"]
+    assert e["convection"] < 0
+    assert e["balance_error"] < 0.01
+    for k in (2, 3):
+        rep = json.loads((root / "remesh" / f"remesh-{k:03d}.json").read_text())
+        removed = rep["measure_old"] - rep["measure_new"]
+        exact = D.bore_volume(rep["depth_new"], 0.002, ANGLE) - D.bore_volume(rep["depth_old"], 0.002, ANGLE)
+        assert abs(removed - exact) <= exact * (0.0015 / 0.002) ** 2 / 4      # chord error of h_bore on R
+    assert len(list((root / "vtu").glob("inc-*.vtu"))) == 4
+    assert (root / "tables" / "drilling-steps.csv").is_file()

@@ -152,7 +152,14 @@ class Process:
         (files.root / "meshes").mkdir(exist_ok=True)
         row = {"step": k, "kind": step.kind, "depth": step.depth, "time": step.time,
                "dt": step.time - (self.rows[-1]["time"] if self.rows else 0.0)}
-        if not state.segments:
+        restart = None
+        if state.segments and step.depth == self.depth_prev:
+            # nothing removed (a dwell): the body and its mesh stay, the state goes on as it is
+            seg, mesh = state.segments[-1], self.mesh
+            restart = str(files.fem / f"inc-{state.last[0]:04d}")
+            row.update(chips_heat=0.0, nodes_outside_old_mesh=0, remesh_seconds=0.0, transfer_seconds=0.0,
+                       chips_seconds=0.0)
+        elif not state.segments:
             mesh = self.build(step.depth, files.root / mesh_rel)
             seg = {"first": k, "mesh": mesh_rel, "ubase": None, "eps0": None}
             row.update(chips_heat=0.0, energy_after_transfer=0.0, nodes_outside_old_mesh=0,
@@ -179,6 +186,8 @@ class Process:
                                          files.root / state_rel, self.g.h, self.h_bore, "", mesher=mesher,
                                          deformed=False)
             mesh = built["mesh"]
+            if self.block.transfer == "conservative":
+                self.conserve_heat(old_mesh, old_inc, mesh, files.root / state_rel, rep)
             seg = {"first": k, "mesh": mesh_rel, "ubase": f"{state_rel}/ubase.txt", "eps0": f"{state_rel}/eps0.txt",
                    "state": state_rel}
             rep.update({"step": k, "depth_old": self.depth_prev, "depth_new": step.depth, "chips_heat": chips,
@@ -190,7 +199,9 @@ class Process:
             row.update(chips_heat=chips, energy_after_transfer=self.energy(mesh, t_new),
                        nodes_outside_old_mesh=rep["nodes_outside_old_mesh"], new_nodes=rep["new_nodes"],
                        remesh_seconds=rep["remesh_seconds"], transfer_seconds=rep["transfer_seconds"])
-        state.segments.append(seg)
+        if restart is None:
+            state.segments.append(seg)
+            restart = seg.get("state")
         self.mesh = mesh
         row["mesh_nodes"] = len(mesh["points"])
         row["removed_volume"] = geometry.bore_volume(step.depth, self.block.diameter / 2, self.block.point_angle)
@@ -202,10 +213,22 @@ class Process:
         row["heat_in"] = row["dt"] * sum(fluxes[n] * areas[n] for n in fluxes)
         row.update({f"area_{n}": a for n, a in areas.items()})
         traction = -self.block.thrust_force() / areas["bore_bottom"] if areas["bore_bottom"] > 0 else 0.0
-        self.launch(k, [step.time], seg, fluxes, traction, restart=seg.get("state"))
+        self.launch(k, [step.time], seg, fluxes, traction, restart=restart)
         row["launch_seconds"] = self.state.launches[-1]["wall"]
         self.depth_prev = step.depth
         self.close_rows([row])
+
+    def conserve_heat(self, old_mesh: dict, old_inc: Path, mesh: dict, state_dir: Path, rep: dict) -> None:
+        """Replace the interpolated temperature by its lumped L2 projection (keeps the heat the body holds)."""
+        t0 = time.perf_counter()
+        T_old = output.read_array(old_inc / "therm_T.node.txt")
+        rep["energy_interpolated"] = self.energy(mesh, output.read_array(state_dir / "therm_T.node.txt"))
+        T_new, _ = conservative_transfer(old_mesh["points"], old_mesh["cells"], T_old, mesh["points"], mesh["cells"])
+        output.write_array(state_dir / "therm_T.node.txt", T_new)
+        if output.read_array(state_dir / "therm_T.qp.txt").size == len(mesh["cells"]):     # P1: one point per cell
+            output.write_array(state_dir / "therm_T.qp.txt", transfer.nodes_to_cells(mesh["cells"], T_new))
+        rep["max_T_after"] = float(T_new.max())
+        rep["transfer_seconds"] += time.perf_counter() - t0
 
     def cool(self, times: list[float]) -> None:
         """The drill is withdrawn: no flux, no thrust; the part cools on the last mesh."""
@@ -367,6 +390,44 @@ class Process:
         self.progress(f"  heat in {heat_in:.4g} J = stored {d_energy:.4g} + chips {chips:.4g} - convection {conv:.4g}"
                       f" - thermoelastic {te:.3g}; mismatch {abs(mismatch) / scale:.2e} (transfer defect {defect:.3g} J)")
         self.progress(f"  tables in {tables}, pictures and drilling.json in {root}")
+
+
+# Degree-2 rules with interior points (Keast 1986 for the tetrahedron; Strang-Fix for the triangle):
+# barycentric points and weights (sum 1).
+_A3, _B3 = 0.5854101966249685, 0.1381966011250105
+RULES = {3: (np.array([[_A3, _B3, _B3, _B3], [_B3, _A3, _B3, _B3], [_B3, _B3, _A3, _B3], [_B3, _B3, _B3, _A3]]),
+             np.full(4, 0.25)),
+         2: (np.array([[2 / 3, 1 / 6, 1 / 6], [1 / 6, 2 / 3, 1 / 6], [1 / 6, 1 / 6, 2 / 3]]), np.full(3, 1 / 3))}
+
+
+def conservative_transfer(old_points, old_cells, values, new_points, new_cells):
+    """Nodal field onto a new mesh by the lumped L2 projection ``v_i = int phi_i v_old / int phi_i``.
+
+    For P1 the integral of the result is ``sum_i v_i int phi_i``, i.e. the quadrature of ``int v_old`` over
+    the new mesh: the heat the new body holds is the heat the old field had there (exact where the old
+    field is linear on a new element; the quadrature sees the kinks of the old field only to second
+    order), and the weights are positive, so no new extrema (interpolation instead adds O(h^2 v'') per
+    transfer, always of the sign of the field's curvature). Returns ``(values, points outside)``.
+
+    >>> p = np.array([[0., 0], [1, 0], [1, 1], [0, 1]]); t = np.array([[0, 1, 2], [0, 2, 3]])
+    >>> v, _ = conservative_transfer(p, t, p[:, 0] ** 2, p[::-1], t[:, ::-1])
+    >>> a = remeshing.cell_volumes(p, t); bool(abs(a @ transfer.nodes_to_cells(t, v) - a @ transfer.nodes_to_cells(t, p[:, 0] ** 2)) < 1e-15)
+    True
+    """
+    if transfer._same_mesh(old_points, old_cells, new_points, new_cells):
+        return np.asarray(values, dtype=float).copy(), 0          # nothing removed: the identity
+    dim = new_cells.shape[1] - 1
+    bary, w = RULES[dim]
+    pts = np.asarray(new_points, dtype=float)[:, :dim]
+    q = np.einsum("qj,cjk->cqk", bary, pts[new_cells]).reshape(-1, dim)
+    vq, outside = transfer.transfer_nodal(old_points, old_cells, values, q)
+    vq = vq.reshape(len(new_cells), len(w))
+    vol = remeshing.cell_volumes(pts, new_cells)
+    # int phi_j v over a cell: sum_q w_q |K| bary_qj v_q
+    contrib = vol[:, None] * np.einsum("q,qj,cq->cj", w, bary, vq)
+    mass = np.bincount(new_cells.ravel(), weights=np.repeat(vol / (dim + 1), dim + 1), minlength=len(pts))
+    load = np.bincount(new_cells.ravel(), weights=contrib.ravel(), minlength=len(pts))
+    return load / mass, outside
 
 
 def removed_slice_quadrature(d0: float, d1: float, radius: float, point_angle: float, height: float,

@@ -61,6 +61,7 @@ class Drilling(BaseModel):
     wall_fraction: float = Field(0.3, ge=0, le=1, description="share of the workpiece heat entering along the bore wall (rest at the bottom) [1]")
     bore_h: float = Field(0.0, ge=0, description="convection coefficient on the bore surfaces (MQL, air; 0: none) [W/m^2/K]")
     bore_T_inf: float = Field(293.15, gt=0, description="ambient temperature of the bore convection [K]")
+    transfer: Literal["conservative", "interpolate"] = Field("conservative", description="temperature onto the new mesh: conservative (lumped L2 projection, keeps the heat) or interpolate (nodal interpolation of remesh_state)")
     h_bore: Optional[float] = Field(None, gt=0, description="element size at the bore wall and bottom [m]; default geometry.h / 3")
     grade: Optional[float] = Field(None, gt=0, description="distance over which the size grows from h_bore to geometry.h [m]; default 2 D")
     probes: dict[str, list[float]] = Field(default_factory=dict, description="thermocouples: name -> position [m]")
