@@ -161,3 +161,20 @@ def test_energy_identity_with_removal(tmp_path):
         assert abs(removed - exact) <= exact * (0.0015 / 0.002) ** 2 / 4      # chord error of h_bore on R
     assert len(list((root / "vtu").glob("inc-*.vtu"))) == 4
     assert (root / "tables" / "drilling-steps.csv").is_file()
+
+
+@pytest.mark.parametrize("change, message", [
+    (('builder = "drilled-block"\nx = [-0.008, 0.008]      # m\ny = [-0.008, 0.008]      # m\nheight = 0.012           # m',
+      'builder = "box"'), "geometry.builder"),
+    (('force = "given"', 'force = "kienzle"'), "kc11"),
+    (('height = 0.012           # m', 'height = 0.012\ndiameter = 0.004'), "geometry.diameter"),
+])
+def test_bad_drilling_scene_names_the_key(change, message):
+    from wendel.scene import SceneError, parse
+    import tomllib
+
+    text = DRILL_SCENE.format(extra="depth = 0.004").replace(*change)
+    assert text != DRILL_SCENE.format(extra="depth = 0.004")
+    with pytest.raises(SceneError) as err:
+        parse(tomllib.loads(text), "x.toml")
+    assert "x.toml" in str(err.value) and message in str(err.value)
