@@ -7,10 +7,11 @@ start_depth) / steps``, then dwells at the bottom):
    (:mod:`wendel.meshes.drilling`: OCC boolean, graded mesh, boundaries re-tagged by geometry);
 2. **chips**: the heat content ``int rho c (T - T_0) dV`` of the removed slice (between the old and the
    new bore) is integrated on the old mesh before removal (Gauss quadrature in (r, s, theta));
-3. **transfer**: temperature, total strain, plastic variables and the displacement reached go over
-   to the new mesh (:func:`wendel.remeshing.remesh_state` with the removal as its mesher, in the
-   reference configuration); the new mesh lies inside the old one, the report counts the new nodes
-   that needed extrapolation (outside the old mesh: chords of the old curved surfaces);
+3. **transfer**: the displacement reached, temperature and plastic variables go over to the new mesh
+   (:func:`wendel.remeshing.remesh_state` with the removal as its mesher, in the reference
+   configuration: small strain; the temperature by a conservative projection, see
+   :func:`conservative_transfer`); the new mesh lies inside the old one, the report counts the new
+   nodes that needed extrapolation (outside the old mesh: chords of the old curved surfaces);
 4. **solve**: one FreeFEM increment of the thermo-mechanics over the step's time with the process
    loads on the new surfaces: the heat flux ``eta_w P_c`` split between bore bottom and wall
    (:class:`wendel.blocks.drilling.Drilling` has the Kienzle force model), the thrust as a traction on
@@ -33,6 +34,7 @@ from __future__ import annotations
 import csv
 import json
 import math
+import shutil
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -188,8 +190,11 @@ class Process:
             mesh = built["mesh"]
             if self.block.transfer == "conservative":
                 self.conserve_heat(old_mesh, old_inc, mesh, files.root / state_rel, rep)
-            seg = {"first": k, "mesh": mesh_rel, "ubase": f"{state_rel}/ubase.txt", "eps0": f"{state_rel}/eps0.txt",
-                   "state": state_rel}
+            # Small strain on nested bodies: the displacement reached is the state (its strain is compatible on
+            # the new mesh); remesh_state's pre-strain eps0 (for a remesh of the deformed body) is not used,
+            # its cell-node-cell recovery would leave incompatible strains, i.e. spurious residual stresses.
+            shutil.copyfile(files.root / state_rel / "ubase.txt", files.root / state_rel / "u.node.txt")
+            seg = {"first": k, "mesh": mesh_rel, "ubase": None, "eps0": None, "state": state_rel}
             rep.update({"step": k, "depth_old": self.depth_prev, "depth_new": step.depth, "chips_heat": chips,
                         "chips_points_outside": outside})
             (files.root / "remesh").mkdir(exist_ok=True)
