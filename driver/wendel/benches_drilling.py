@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import csv
 import json
+import math
 import shutil
 from pathlib import Path
 
@@ -51,6 +52,7 @@ def drilling(quick: bool, workdir: Path) -> list[dict]:
         rows.append({"case": tag, "step": "all", "balance_error": e["balance_error"],
                      "transfer_defect_J": e["transfer_defect"], "heat_in_J": e["heat_in"],
                      "chips_J": e["chips_heat"], "wall_time": summary["wall_time"]})
+    rows += removed_volume_rows(workdir)
     # the 3D target: its final mesh (gmsh only), cost from the measured seconds per node
     built = geometry.drilled(workdir / "target.msh", "cylinder", depth=TARGET["depth"], diameter=TARGET["diameter"],
                              radius=TARGET["radius"], height=TARGET["height"], h=TARGET["h"], h_bore=TARGET["h_bore"])
@@ -63,4 +65,28 @@ def drilling(quick: bool, workdir: Path) -> list[dict]:
     rows.append({"case": "estimate-3d-10x50mm-50-steps", "nodes_first": first.nodes, "nodes_last": built.nodes,
                  "solve_seconds_per_node": solve, "remesh_transfer_seconds_per_node": other,
                  "estimated_seconds": TARGET["steps"] * mean_nodes * (solve + other)})
+    return rows
+
+
+def removed_volume_rows(workdir: Path) -> list[dict]:
+    """The removed volume of the boolean against V(d): block workpiece (flat outer faces), 3D and (r, z)."""
+    from . import output, remeshing
+    from .meshes import drilling as geometry
+
+    workdir.mkdir(parents=True, exist_ok=True)
+    rows = []
+    for depth in (0.001, 0.004, 0.012):
+        b = geometry.drilled(workdir / "vol.msh", "block", depth=depth, diameter=0.006, x=(-0.012, 0.012),
+                             y=(-0.012, 0.012), height=0.02, h=0.003, h_bore=0.0008)
+        pts, cells = output.read_mesh(b.path, 3)
+        removed = 0.024 * 0.024 * 0.02 - remeshing.cell_volumes(pts, cells).sum()
+        s = geometry.drilled_section(workdir / "vol2.msh", depth=depth, diameter=0.006, radius=0.012, height=0.02,
+                                     h=0.002, h_bore=0.0005)
+        p2, c2 = output.read_mesh(s.path, 2)
+        p2 = p2[:, :2]
+        removed2 = math.pi * 0.012 ** 2 * 0.02 - (2 * math.pi * p2[c2].mean(axis=1)[:, 0]
+                                                  * remeshing.cell_volumes(p2, c2)).sum()
+        exact = geometry.bore_volume(depth, 0.003, 118.0)
+        rows.append({"case": "removed-volume", "step": f"depth {depth * 1e3:g} mm", "volume_exact": exact,
+                     "volume_3d_rel_error": removed / exact - 1, "volume_rz_rel_error": removed2 / exact - 1})
     return rows
