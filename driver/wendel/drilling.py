@@ -513,6 +513,13 @@ def _write_csv(path: Path, rows: list[dict]) -> None:
         w.writerows(rows)
 
 
+def _time_axis(ax, t) -> None:
+    """Time in s; logarithmic when the cooling lasts far longer than the drilling."""
+    ax.set_xlabel("time [s]")
+    if len(t) > 1 and t[0] > 0 and t[-1] / t[0] > 100:
+        ax.set_xscale("log")
+
+
 def plots(root: Path, rows: list[dict], probes: list[dict], profiles: list[dict]) -> None:
     """PNGs: probe temperatures, bore diameter error and wall stresses along the depth, energies."""
     import matplotlib
@@ -525,7 +532,7 @@ def plots(root: Path, rows: list[dict], probes: list[dict], profiles: list[dict]
         t = [p["time"] for p in probes]
         for n in [k for k in probes[0] if k != "time"]:
             ax.plot(t, [p[n] for p in probes], marker=".", label=n)
-        ax.set_xlabel("time [s]")
+        _time_axis(ax, t)
         ax.set_ylabel("temperature [K]")
         ax.set_title("thermocouples")
         ax.legend()
@@ -557,7 +564,7 @@ def plots(root: Path, rows: list[dict], probes: list[dict], profiles: list[dict]
     ax.plot(t, [r["energy"] for r in rows], label="in the body")
     ax.plot(t, np.cumsum([r["chips_heat"] for r in rows]), label="left with the chips")
     ax.plot(t, -np.cumsum([r["convection"] for r in rows]), label="convection losses")
-    ax.set_xlabel("time [s]")
+    _time_axis(ax, t)
     ax.set_ylabel("energy [J]")
     ax.legend()
     fig.tight_layout()
