@@ -186,3 +186,19 @@ def test_bad_drilling_scene_names_the_key(change, message):
     with pytest.raises(SceneError) as err:
         parse(tomllib.loads(text), "x.toml")
     assert "x.toml" in str(err.value) and message in str(err.value)
+
+
+def test_plastic_drilling_leaves_residual_stress(tmp_path):
+    """With a low yield stress the thermal stresses of drilling yield the wall: the plastic strain goes over
+    at every removal (its integral kept within 10 %), and stress remains after cooling to ambient."""
+    text = "depth = 0.006\nsteps = 3\ncooling = 1e6\ncooling_steps = 1\nthrust = 100.0\n[plasticity]\n" \
+           "law = \"linear\"\nsigma0 = 15e6            # Pa\nH = 1e9                  # Pa"
+    root, dr = _drill(tmp_path, text)
+    assert dr["energy"]["balance_error"] < 0.01
+    for k in (2, 3):
+        rep = json.loads((root / "remesh" / f"remesh-{k:03d}.json").read_text())
+        assert rep["integral_p_before"] > 0
+        assert rep["integral_p_after"] == pytest.approx(rep["integral_p_before"], rel=0.1)
+    profiles = json.loads((root / "drilling.json").read_text())["profiles"]
+    hot, cold = profiles[-2], profiles[-1]
+    assert np.nanmax(np.abs(cold["hoop_stress"])) > 0.05 * np.nanmax(np.abs(hot["hoop_stress"]))

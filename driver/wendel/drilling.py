@@ -24,7 +24,7 @@ increments). Time runs as the load factor: ``t = lf * T_total``; the traction ta
 
 Energy bookkeeping (J, every step, ``summary.json["drilling"]["energy"]``): heat put in by the flux =
 change of the thermal energy of the body + heat removed with the chips - convection (and the
-thermoelastic term) + the transfer defect (the heat the interpolation onto the new mesh created).
+thermoelastic and plastic heat) + the transfer defect (the heat the transfer onto the new mesh created).
 What is not modelled: the chips as bodies (their heat leaves at once), tool wear, the chisel edge's
 forces, the torque as a traction (3D), frictional contact of the margins with the wall.
 """
@@ -128,6 +128,7 @@ class Process:
         self.energy_prev = 0.0               # thermal energy at the end of the last step (J)
         self.heat_boundary_prev = 0.0
         self.heat_te_prev = 0.0
+        self.heat_pl_prev = 0.0
         self.depth_prev = self.block.start_depth
 
     # ---- the geometry of the workpiece
@@ -299,9 +300,11 @@ class Process:
             row["heat_boundary"] = rec["heat_boundary"] - self.heat_boundary_prev
             row["convection"] = row["heat_boundary"] - row["heat_in"]
             row["heat_thermoelastic"] = rec["heat_thermoelastic"] - self.heat_te_prev
+            row["heat_plastic"] = rec["heat_plastic"] - self.heat_pl_prev
             row["freefem_energy_change"] = rec["thermal_energy_change"]
             row["max_temperature"] = rec["max_temperature"]
             self.heat_boundary_prev, self.heat_te_prev = rec["heat_boundary"], rec["heat_thermoelastic"]
+            self.heat_pl_prev = rec["heat_plastic"]
             self.energy_prev = energy
             self.rows.append(row)
             self.record_probes(inc, row, T)
@@ -356,9 +359,10 @@ class Process:
         chips = sum(r["chips_heat"] for r in rows)
         conv = sum(r["convection"] for r in rows)
         te = sum(r["heat_thermoelastic"] for r in rows)
+        plastic = sum(r["heat_plastic"] for r in rows)
         defect = sum(r["transfer_defect"] for r in rows)
         d_energy = rows[-1]["energy"] if rows else 0.0
-        mismatch = heat_in + conv + te - d_energy - chips
+        mismatch = heat_in + conv + te + plastic - d_energy - chips
         scale = max(abs(heat_in), 1e-300)
         shares = [(r.get("remesh_seconds", 0) + r.get("transfer_seconds", 0) + r.get("chips_seconds", 0))
                   / max(r.get("remesh_seconds", 0) + r.get("transfer_seconds", 0) + r.get("chips_seconds", 0)
@@ -370,7 +374,7 @@ class Process:
                         "removal_steps": sum(r["kind"] != "cool" for r in rows),
                         "cooling_increments": sum(r["kind"] == "cool" for r in rows)},
             "energy": {"heat_in": heat_in, "thermal_energy_change": d_energy, "chips_heat": chips,
-                       "convection": conv, "thermoelastic": te, "transfer_defect": defect,
+                       "convection": conv, "thermoelastic": te, "plastic_heat": plastic, "transfer_defect": defect,
                        "balance_mismatch": mismatch, "balance_error": abs(mismatch) / scale},
             "remesh": {"nodes_extrapolated": [r.get("nodes_outside_old_mesh", 0) for r in rows if r["kind"] != "cool"],
                        "new_nodes": [r.get("new_nodes", r["mesh_nodes"]) for r in rows if r["kind"] != "cool"],
