@@ -226,7 +226,7 @@ def drilled_section(path: Path, depth: float = 0.0, diameter: float = 0.01, poin
         return _write(gmsh, Path(path), 2, names)
 
 
-@register("drilled-cylinder")
+@register("drilled-cylinder", boundaries=["bore_wall", "bore_bottom", "top", "bottom", "outer"])
 def drilled_cylinder(path: Path, depth=0.0, diameter=0.01, point_angle=118.0, radius=0.02, height=0.03,
                      h=0.004, h_bore=None, grade=None) -> Built:
     """A cylinder workpiece (radius, height; m) with the bore of a drill whose tip is ``depth`` below z = H."""
@@ -234,7 +234,7 @@ def drilled_cylinder(path: Path, depth=0.0, diameter=0.01, point_angle=118.0, ra
                    h_bore=h_bore, grade=grade)
 
 
-@register("drilled-block")
+@register("drilled-block", boundaries=["bore_wall", "bore_bottom", "top", "bottom", "left", "right", "front", "back"])
 def drilled_block(path: Path, depth=0.0, diameter=0.01, point_angle=118.0, x=(-0.02, 0.02), y=(-0.02, 0.02),
                   height=0.03, axis=(0.0, 0.0), h=0.004, h_bore=None, grade=None) -> Built:
     """A block workpiece [x] x [y] x [0, height] (m) with the bore of a drill along the vertical ``axis``."""
@@ -242,7 +242,7 @@ def drilled_block(path: Path, depth=0.0, diameter=0.01, point_angle=118.0, x=(-0
                    h_bore=h_bore, grade=grade)
 
 
-@register("drilled-section")
+@register("drilled-section", boundaries=["bore_wall", "bore_bottom", "top", "bottom", "outer", "symmetry_x"])
 def drilled_section_builder(path: Path, depth=0.0, diameter=0.01, point_angle=118.0, radius=0.02, height=0.03,
                             h=0.004, h_bore=None, grade=None) -> Built:
     """The axisymmetric (r, z) section of a drilled cylinder (for axisymmetric scenes)."""

@@ -11,7 +11,7 @@ import pytest
 
 from wendel.meshes import LABELS
 from wendel.meshes import drilling as D
-from wendel.remeshing import cell_volumes
+from wendel.remesh.step import cell_volumes
 
 R, DIA, ANGLE = 0.003, 0.006, 118.0
 
@@ -70,8 +70,8 @@ def test_removed_volume_axisymmetric_section(tmp_path, depth):
 
 # ---- the process loop (real gmsh + FreeFEM on tiny meshes)
 
-from wendel import output  # noqa: E402
-from wendel.run import run  # noqa: E402
+from wendel.results import vtu as output  # noqa: E402
+from wendel.loop import run  # noqa: E402
 
 DRILL_SCENE = """
 description = "test: drilling a block"
