@@ -71,6 +71,8 @@ def _when(run: Path, event: str) -> bool:
     ck = run / "checkpoint.json"
     if event.startswith("committed-"):
         return (run / "fem" / f"inc-{int(event.split('-')[1]):04d}" / "done").is_file()
+    if event == "started":          # the scene is saved, the first checkpoint not yet written
+        return (run / "scene.resolved.json").is_file()
     if event == "meshing":
         return (run / "meshes").is_dir() and any((run / "meshes").iterdir())
     if event == "transfer":
@@ -85,7 +87,7 @@ def _when(run: Path, event: str) -> bool:
     raise ValueError(event)
 
 
-KILL_POINTS = ["committed-1", "committed-2", "meshing", "transfer", "reequilibrating", "committed-4",
+KILL_POINTS = ["started", "committed-1", "committed-2", "meshing", "transfer", "reequilibrating", "committed-4",
                "committed-5", "after-2.5"]
 
 

@@ -41,6 +41,8 @@ def run(scene_path: str | Path, smoke: bool = False, ranks: int | None = None, o
     """
     if resume is not None:
         root = Path(resume).resolve()
+        if not (root / "checkpoint.json").is_file() and (root / "scene.resolved.json").is_file():
+            return _restart(root, progress)
         with guarded(root):
             files, scene, state = _resume(root, progress)
             progress(f"resuming {files.root} after increment {state.last[0]} (load factor {state.last[1]:g})")
@@ -293,6 +295,25 @@ def _new_run_dir(scene_path: Path, smoke: bool) -> Path:
         except FileExistsError:
             k += 1
             d = base.with_name(f"{base.name}-{k}")
+
+
+def _restart(root: Path, progress) -> Path:
+    """A run stopped before its first checkpoint (while meshing): nothing was computed, so it starts again
+    in its own folder from the scene it saved there."""
+    scene = Scene.model_validate(json.loads((root / "scene.resolved.json").read_text()))
+    smoke = False
+    with contextlib.suppress(OSError, ValueError, KeyError):
+        smoke = bool(json.loads((root / "provenance.json").read_text())["smoke"])
+    progress(f"resuming {root}: it stopped before its first increment; starting it again")
+    with tempfile.TemporaryDirectory() as tmp:
+        source = Path(tmp) / "scene.toml"
+        if (root / "scene.toml").is_file():
+            shutil.copyfile(root / "scene.toml", source)
+        else:
+            source.write_text("# the scene file was not saved before the run stopped; see scene.resolved.json\n")
+        for p in root.iterdir():
+            shutil.rmtree(p) if p.is_dir() else p.unlink()
+        return run_scene(scene, source, root, smoke, progress)
 
 
 def _resume(root: Path, progress=print) -> tuple[RunFiles, Scene, State]:

@@ -46,7 +46,9 @@ def _freefem_version() -> str:
 def write_provenance(root: Path, scene_path: Path, scene, smoke: bool) -> None:
     """The scene as run and where it ran: commit, versions, command line, host, start time."""
     shutil.copyfile(scene_path, root / "scene.toml")
-    (root / "scene.resolved.json").write_text(json.dumps(scene.model_dump(mode="json"), indent=1))
+    tmp = root / "scene.resolved.json.tmp"      # atomic: a run stopped before its checkpoint restarts from it
+    tmp.write_text(json.dumps(scene.model_dump(mode="json"), indent=1))
+    os.replace(tmp, root / "scene.resolved.json")
     versions = {"wendel": __version__, "python": sys.version.split()[0], "freefem++": _freefem_version()}
     for pkg in ("gmsh", "meshio", "numpy", "scipy", "pydantic", "pyvista", "matplotlib"):
         try:
