@@ -345,8 +345,8 @@ class Process:
     def record_probes(self, inc: int, row: dict, T: np.ndarray) -> None:
         if not self.block.probes:
             return
-        names = list(self.block.probes)
-        pos = np.array([self.block.probes[n] for n in names], dtype=float)
+        names = [p.name for p in self.block.probes]
+        pos = np.array([p.position for p in self.block.probes], dtype=float)
         inside = transfer.locate(self.mesh["points"], self.mesh["cells"], pos)[0] >= 0
         vals, _ = transfer.transfer_nodal(self.mesh["points"], self.mesh["cells"], T, pos)
         self.probes.append({"time": row["time"], **{n: float(v) if ok else float("nan")
@@ -394,7 +394,7 @@ class Process:
                        "step_seconds": [r.get("remesh_seconds", 0) + r.get("transfer_seconds", 0)
                                         + r.get("chips_seconds", 0) + r.get("launch_seconds", 0)
                                         for r in rows if r["kind"] != "cool"]},
-            "probes_peak": {n: float(np.nanmax([p[n] for p in self.probes])) for n in b.probes} if self.probes else {},
+            "probes_peak": {n: float(np.nanmax([p[n] for p in self.probes])) for n in (p.name for p in b.probes)} if self.probes else {},
         }
         if self.profiles:
             last = self.profiles[-1]

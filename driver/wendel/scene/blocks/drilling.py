@@ -34,6 +34,15 @@ DRILLED_BUILDERS = ("drilled-cylinder", "drilled-block")
 FORCE_MODELS = ("kienzle", "given")
 
 
+class Probe(BaseModel):
+    """A thermocouple: its name and position."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    name: str = Field(..., min_length=1, description="name of the thermocouple (column of tables/probes.csv)")
+    position: list[float] = Field(..., min_length=3, max_length=3, description="position (x, y, z) [m]")
+
+
 class Drilling(BaseModel):
     """Drill, process and outputs of a drilling scene."""
 
@@ -64,7 +73,7 @@ class Drilling(BaseModel):
     transfer: Literal["conservative", "interpolate"] = Field("conservative", description="temperature onto the new mesh: conservative (lumped L2 projection, keeps the heat) or interpolate (nodal interpolation of remesh_state)")
     h_bore: Optional[float] = Field(None, gt=0, description="element size at the bore wall and bottom [m]; default geometry.h / 3")
     grade: Optional[float] = Field(None, gt=0, description="distance over which the size grows from h_bore to geometry.h [m]; default 2 D")
-    probes: dict[str, list[float]] = Field(default_factory=dict, description="thermocouples: name -> position [m]")
+    probes: list[Probe] = Field(default_factory=list, description="thermocouples ([[drilling.probes]] tables: name, position)")
     bore_bins: int = Field(10, ge=2, description="depth bins of the bore diameter error profile [1]")
 
     @model_validator(mode="after")
@@ -73,9 +82,9 @@ class Drilling(BaseModel):
             raise ValueError("depth must exceed start_depth (or give a dwell: a drill that does not advance)")
         if self.force == "kienzle" and self.kc11 == 0:
             raise ValueError("force = \"kienzle\" needs kc11 (the material's k_c1.1 [Pa])")
-        for name, p in self.probes.items():
-            if len(p) not in (2, 3):
-                raise ValueError(f"probes.{name}: a position has 2 (r, z) or 3 (x, y, z) coordinates")
+        names = [p.name for p in self.probes]
+        if len(set(names)) != len(names):
+            raise ValueError(f"probes: two thermocouples have the same name ({', '.join(names)})")
         return self
 
     # ---- process model (formulas in the module docstring)
