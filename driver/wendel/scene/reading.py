@@ -126,8 +126,10 @@ def _indicator(scene: Scene, source: str) -> None:
     valid = list(CELL_FIELDS) + [
         f for name in scene.blocks for f in BLOCKS[name].fields if f in BLOCK_CELL_FIELDS]
     if scene.remesh.indicator not in valid:
+        owners = [name for name, b in BLOCKS.items() if scene.remesh.indicator in b.fields]
+        hint = f"; it comes with a [{owners[0]}] table" if owners else ""
         raise SceneError(f"{source}: remesh.indicator: {scene.remesh.indicator!r} is not a cell field of this "
-                         f"scene; valid: {', '.join(valid)} (or \"\" for a uniform size)")
+                         f"scene; valid: {', '.join(valid)} (or \"\" for a uniform size){hint}")
 
 
 def load(path: str | Path, smoke: bool = False) -> Scene:
