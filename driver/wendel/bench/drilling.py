@@ -1,5 +1,6 @@
 """Benchmark ``drilling``: cost of a removal step (remesh + chips + transfer vs the FreeFEM solve) and
-the energy balance of the two temperature transfers, on workflows/drilling-3d.toml at its smoke size.
+the energy balance of the two temperature transfers, on workflows/drilling-3d.toml at its smoke size (h)
+with 3 removal steps.
 
 Rows: one per removal step (mesh nodes, seconds of remesh, chips quadrature, transfer and FreeFEM
 launch, and the share of remesh + transfer in the step), one summary row per transfer (balance error,
@@ -36,8 +37,8 @@ def drilling(quick: bool, workdir: Path) -> list[dict]:
         scene = load(WORKFLOWS / "drilling-3d.toml", smoke=True)
         scene.output.png = False
         scene.drilling.transfer = transfer
-        root = run_scene(scene, WORKFLOWS / "drilling-3d.toml", workdir / tag, smoke=True,
-                                progress=lambda *_: None)
+        scene.drilling.steps = 3          # the smoke size (h) with 3 removal steps, whatever smoke.steps says
+        root = run_scene(scene, WORKFLOWS / "drilling-3d.toml", workdir / tag, progress=lambda *_: None)
         summary = json.loads((root / "summary.json").read_text())
         steps = [r for r in csv.DictReader(open(root / "tables" / "drilling-steps.csv")) if r["kind"] != "cool"]
         for r in steps:
