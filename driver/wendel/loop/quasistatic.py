@@ -80,6 +80,10 @@ def run_scene(scene: Scene, scene_path: Path, out: Path, smoke: bool = False, pr
     except OSError as exc:
         raise RunFolderError(f"run folder (--out) {out}: cannot be created or written: {exc.strerror}") from None
     check_size(scene, str(scene_path))       # h may have been scaled since the scene was read (studies)
+    if getattr(scene, "drilling", None) is not None:      # a process of removal steps: wendel.loop.drilling
+        from .drilling import run as run_drilling
+        with guarded(files.root):
+            return run_drilling(scene, scene_path, files.root, smoke, progress)
     with guarded(files.root):
         summary.write_provenance(files.root, Path(scene_path), scene, smoke)
         state = State(pending=scene.loading.load_factors())
