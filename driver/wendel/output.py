@@ -82,6 +82,18 @@ def increment_fields(inc_dir: Path, n_points: int, n_cells: int, dimension: int)
     return point_data, cell_data
 
 
+def current_points(point_data: dict, points: np.ndarray) -> np.ndarray:
+    """Points at the current positions of an updated-Lagrangian increment (its ``position`` field).
+
+    >>> current_points({"position": np.array([[1.0, 2.0, 0.0]])}, np.zeros((1, 3)))
+    array([[1., 2., 0.]])
+    """
+    pos = np.asarray(point_data.pop("position"), dtype=float)
+    if pos.shape != (len(points), 3):
+        raise ValueError(f"position field of shape {pos.shape} does not fit {len(points)} points")
+    return pos
+
+
 def write_vtu(path: Path, points, cells, dimension: int, point_data, cell_data) -> None:
     """Write one VTU (atomic: written beside, then renamed)."""
     mesh = meshio.Mesh(points, [(CELL_TYPES[dimension], cells)], point_data=point_data, cell_data=cell_data)
@@ -107,7 +119,8 @@ def read_pvd(path: Path) -> list[tuple[float, Path]]:
     return [(float(d.get("timestep")), path.parent / d.get("file")) for d in root.iter("DataSet")]
 
 
-def picture(vtu: Path, png: Path, title: str, warp: float = 0.0, field: str | None = None) -> None:
+def picture(vtu: Path, png: Path, title: str, warp: float = 0.0, field: str | None = None,
+            deformed: bool = False) -> None:
     """Render the deformed body off-screen, coloured by ``field`` (von Mises by default)."""
     os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
     import pyvista as pv
@@ -130,6 +143,8 @@ def picture(vtu: Path, png: Path, title: str, warp: float = 0.0, field: str | No
         # body), magnified to 10% of the size for small ones
         large = umax >= 0.05 * size or "u_total" in grid.point_data
         scale = warp or (1.0 if large else 0.1 * size / umax)
+        if deformed:
+            scale = 0.0         # updated-Lagrangian VTU: the points are the deformed body already
         grid = grid.warp_by_vector("u", factor=scale)
         title = f"{title} (displacement x{scale:.3g})"
     field = field or ("vonMises" if "vonMises" in grid.cell_data else None)

@@ -136,7 +136,8 @@ def _execute(scene: Scene, files: RunFiles, state: State, progress) -> Path:
     if scene.output.png and state.accepted:
         t0 = time.perf_counter()
         last = files.vtu / f"inc-{state.last[0]:04d}.vtu"
-        output.picture(last, files.root / "deformed.png", f"load factor {state.last[1]:g}", scene.output.warp)
+        output.picture(last, files.root / "deformed.png", f"load factor {state.last[1]:g}", scene.output.warp,
+                       deformed=scene.kinematics.updated_lagrangian)
         state.post_seconds += time.perf_counter() - t0
         report.write_summary(files.root, scene, state, dimension)
     return files.root
@@ -285,7 +286,9 @@ def accept(scene: Scene, files: RunFiles, state: State, dimension: int) -> None:
         if scene.output.vtu:
             pdata, cdata = output.increment_fields(d, len(points), len(cells), dimension)
             files.vtu.mkdir(exist_ok=True)
-            output.write_vtu(files.vtu / f"inc-{inc:04d}.vtu", points, cells, dimension, pdata, cdata)
+            # updated-Lagrangian: the VTU is the deformed body itself (points = current positions)
+            at = output.current_points(pdata, points) if scene.kinematics.updated_lagrangian else points
+            output.write_vtu(files.vtu / f"inc-{inc:04d}.vtu", at, cells, dimension, pdata, cdata)
         state.accepted.append((inc, record["load_factor"]))
         state.pending.pop(0)
         report.append_history(files.root, {**record, **extra}, d / "newton.csv")
@@ -349,6 +352,9 @@ def options(scene: Scene, files: RunFiles, dimension: int, segment: dict | None 
     for key in ("ubase", "eps0"):
         if segment.get(key):
             opts += [f"-{key}", str(files.root / segment[key])]
+    if (files.tables / "motion.txt").is_file():
+        opts += ["-bc_motion", str(files.tables / "motion.txt")]
+    opts += kinematics_options(scene)
     bf = scene.body_force
     v = list(bf.value) + [0.0] * (3 - len(bf.value))
     opts += ["-body_id", str(BODY_FORCES[bf.kind]), "-body_fx", repr(v[0]), "-body_fy", repr(v[1]),
@@ -360,12 +366,27 @@ def options(scene: Scene, files: RunFiles, dimension: int, segment: dict | None 
     return opts
 
 
+def kinematics_options(scene: Scene) -> list[str]:
+    """Updated-Lagrangian kinematics: the -D switch of edp/lib/kinematics.idp and its options."""
+    k = scene.kinematics
+    if not k.updated_lagrangian:
+        return []
+    e = k.initial_strain
+    return ["-DUPDATEDLAGRANGIAN=1", "-ul_min_jacobian", repr(k.min_area_ratio),
+            "-ul_eps_xx", repr(e[0]), "-ul_eps_yy", repr(e[1]), "-ul_eps_xy", repr(e[2])]
+
+
 def write_tables(scene: Scene, files: RunFiles, dimension: int) -> None:
     """Boundary condition tables for bc.idp (labels from meshes/labels.py)."""
     files.tables.mkdir(parents=True, exist_ok=True)
-    dirichlet, neumann = [], []
+    dirichlet, neumann, motion = [], [], []
     for name, b in scene.boundary.items():
         lab = LABELS[name]
+        if b.motion:
+            if dimension != 2:
+                raise ValueError(f"boundary.{name}.rotation/gradient: prescribed motions are 2D only")
+            g = b.gradient or [0.0] * 4
+            motion.append(f"{lab} " + " ".join(repr(float(v)) for v in [b.rotation or 0.0, *g, *b.center]))
         for comp, val in enumerate((b.ux, b.uy, b.uz)):
             if val is not None:
                 if comp == 2 and dimension == 2:
@@ -376,6 +397,8 @@ def write_tables(scene: Scene, files: RunFiles, dimension: int) -> None:
             neumann.append(f"{lab} {t[0]!r} {t[1]!r} {t[2]!r} {float(b.pressure or 0.0)!r}")
     (files.tables / "bc.txt").write_text(f"{len(dirichlet)}\n" + "".join(r + "\n" for r in dirichlet))
     (files.tables / "trac.txt").write_text(f"{len(neumann)}\n" + "".join(r + "\n" for r in neumann))
+    if motion:
+        (files.tables / "motion.txt").write_text(f"{len(motion)}\n" + "".join(r + "\n" for r in motion))
 
 
 def _new_run_dir(scene_path: Path, smoke: bool) -> Path:
