@@ -110,15 +110,25 @@ def test_stress_free_rotation_stays_stress_free_and_small_strain_does_not(scene_
     assert increments(root)[-1][1]["vonMises"].max() > 1e10     # rotation taken as strain
 
 
-@pytest.mark.parametrize("scene, axis, reaction, lateral", [
-    ("ul-tension.toml", 0, "reaction_x_2", 1),      # 100 % nominal tension, force on the right end
-    ("ul-compression.toml", 1, "reaction_y_4", 0),  # 50 % height, force on the top platen
+@pytest.mark.parametrize("scene, axis, reaction, lateral, remesh", [
+    ("ul-tension.toml", 0, "reaction_x_2", 1, False),      # 100 % nominal tension, force on the right end
+    ("ul-compression.toml", 1, "reaction_y_4", 0, False),  # 50 % height, force on the top platen
+    ("ul-tension.toml", 0, "reaction_x_2", 1, True),       # remeshed after increment 10 (finer mesh)
 ])
-def test_homogeneous_tension_and_compression_to_large_strain(tmp_path, quiet, scene, axis, reaction, lateral):
+def test_homogeneous_tension_and_compression_to_large_strain(scene_file, tmp_path, quiet, scene, axis, reaction,
+                                                            lateral, remesh):
     """Logarithmic strain exact; Cauchy stress on the material-point curve (1e-8); on the yield surface
-    sigma_y(p) = sigma0 + H p (1e-10); end force = stress x current section (1e-8)."""
-    root = run(WORKFLOWS / scene, out=tmp_path / "r", progress=quiet, png=False)
+    sigma_y(p) = sigma0 + H p (1e-10); end force = stress x current section (1e-8). With a remesh the new
+    mesh is made of the current configuration and the state carries over."""
+    text = (WORKFLOWS / scene).read_text()
+    if remesh:
+        text = text.replace("[output]", "[remesh]\nat = [10]\nh = 0.05\n\n[output]")
+    root = run(scene_file(text, "s.toml"), out=tmp_path / "r", progress=quiet, png=False)
     incs = increments(root)
+    if remesh:
+        assert len(incs) == 21 and incs[10][0]["elements"] > 2 * incs[9][0]["elements"]
+        points, _ = output.read_mesh(root / "meshes" / "mesh-1.msh", 2)
+        assert np.ptp(points[:, 0]) == pytest.approx(1.5, rel=1e-12)     # the current length at 50 %
     loads = [rec["load_factor"] * (1.0 if axis == 0 else -0.5) for rec, _, _ in incs]
     ref = material_point(loads, axis, 70e9, 0.3, 250e6, 1e9)
     names = ["stress_xx", "stress_yy"]
