@@ -215,3 +215,24 @@ def test_an_increment_that_would_tangle_the_mesh_is_cut(scene_file, tmp_path, qu
     assert len(incs) > 1 and incs[-1][0]["load_factor"] == pytest.approx(1.0)
     assert min(rec["ul_min_area_ratio"] for rec, _, _ in incs) > 0.5
     assert np.abs(incs[-1][1]["strain_yy"] / math.log(0.1) - 1).max() < 1e-9     # Newton tolerance
+
+
+@pytest.mark.parametrize("change, words", [
+    ('[kinematics]\nkind = "updated-lagrangian"\n[thermal]\nk = 50.0\nrho = 7800.0\nc = 460.0\nalpha = 1.2e-5\nduration = 1.0\ncoupling = "staggered"\n',
+     "not implemented with [thermal]"),
+    ('[kinematics]\nkind = "large"\n', "valid: small-strain, updated-lagrangian"),
+    ('[kinematics]\ninitial_strain = [1e-3, 0.0, 0.0]\n', "needs kinematics.kind"),
+    ("ROTATE", "no ux/uy/uz beside them"),
+])
+def test_bad_kinematics_tables_are_refused_by_the_scene_check(scene_file, change, words):
+    """`wendel check` exits 2 with the file and the key (no traceback)."""
+    import subprocess
+    import sys
+
+    base = (WORKFLOWS / "smoke.toml").read_text()
+    text = base.replace("[boundary.top]\n", "[boundary.top]\nrotation = 1.0\n") if change == "ROTATE" \
+        else base + "\n" + change
+    path = scene_file(text)
+    out = subprocess.run([sys.executable, "-m", "wendel.cli", "check", str(path)], capture_output=True, text=True)
+    assert out.returncode == 2, out.stdout + out.stderr
+    assert words in out.stdout + out.stderr and "Traceback" not in out.stderr

@@ -173,7 +173,7 @@ def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress)
         loads = files.tables / "loads.txt"
         loads.write_text(f"{len(batch)}\n" + "".join(f"{lf!r}\n" for lf in batch))
         seg = state.segment(inc0)
-        opts = options(scene, files, dimension, seg) + ["-loads", str(loads), "-inc0", str(inc0)]
+        opts = macros(scene) + options(scene, files, dimension, seg) + ["-loads", str(loads), "-inc0", str(inc0)]
         if state.reequilibrate:
             opts += ["-restart", str(files.root / seg["state"])]
         elif state.accepted:
@@ -366,13 +366,18 @@ def options(scene: Scene, files: RunFiles, dimension: int, segment: dict | None 
     return opts
 
 
+def macros(scene: Scene) -> list[str]:
+    """FreeFEM -D switches of the launch (after the entry script's name): modules chosen per scene."""
+    return ["-DUPDATEDLAGRANGIAN=1"] if scene.problem == "mechanics" and scene.kinematics.updated_lagrangian else []
+
+
 def kinematics_options(scene: Scene) -> list[str]:
-    """Updated-Lagrangian kinematics: the -D switch of edp/lib/kinematics.idp and its options."""
+    """Updated-Lagrangian kinematics (edp/lib/kinematics.idp, included by the -D switch of :func:`macros`)."""
     k = scene.kinematics
     if not k.updated_lagrangian:
         return []
     e = k.initial_strain
-    return ["-DUPDATEDLAGRANGIAN=1", "-ul_min_jacobian", repr(k.min_area_ratio),
+    return ["-ul_min_jacobian", repr(k.min_area_ratio),
             "-ul_eps_xx", repr(e[0]), "-ul_eps_yy", repr(e[1]), "-ul_eps_xy", repr(e[2])]
 
 
