@@ -144,6 +144,28 @@ def test_homogeneous_tension_and_compression_to_large_strain(scene_file, tmp_pat
     assert abs(loads[-1]) in (1.0, 0.5)
 
 
+@pytest.mark.parametrize("top", [1.0, -0.5])     # 100 % nominal tension; compression to 50 % height
+def test_uniaxial_tension_and_compression_3d_on_the_closed_form_curve(scene_file, tmp_path, quiet, top):
+    """3D cube, frictionless ends, linear hardening: Cauchy stress against log strain on
+    sigma = sigma0 + E H / (E + H) (|eps| - sigma0 / E) (1e-10), lateral stress 0, the end force equals
+    sigma_y(eps) times the current section (1e-10)."""
+    E, H, s0 = 70e9, 1e9, 250e6
+    text = (WORKFLOWS / "ul-tension-3d.toml").read_text().replace("uz = 1.0 ", f"uz = {top!r} ")
+    root = run(scene_file(text, "t3.toml"), smoke=True, out=tmp_path / "t3", progress=quiet, png=False)
+    incs = increments(root)
+    assert len(incs) == 10
+    for rec, cells, nodes in incs:
+        e = math.log(1 + top * rec["load_factor"])
+        ref = math.copysign(E * abs(e) if E * abs(e) < s0 else s0 + E * H / (E + H) * (abs(e) - s0 / E), e)
+        assert np.abs(cells["strain_zz"] - e).max() < 1e-12
+        assert np.abs(cells["stress_zz"] / ref - 1).max() < 1e-10, (rec["increment"], cells["stress_zz"].mean(), ref)
+        for k in ("stress_xx", "stress_yy", "stress_xy", "stress_xz", "stress_yz"):
+            assert np.abs(cells[k]).max() < 1e-8 * abs(ref)
+        pos = nodes["position"].reshape(-1, 3)
+        section = np.ptp(pos[:, 0]) * np.ptp(pos[:, 1])
+        assert rec["reaction_z_4"] / (ref * section) == pytest.approx(1.0, abs=1e-10)
+
+
 def test_elastic_simple_shear_follows_the_jaumann_rate(tmp_path, quiet):
     """gamma = 4: sigma_xy = G sin(gamma), sigma_xx = -sigma_yy = G (1 - cos(gamma)) (hypoelastic, Jaumann),
     second order in the shear strain increment."""
