@@ -14,22 +14,27 @@ from .scene import load
 
 @register("ul")
 def ul_bench(quick: bool, workdir: Path) -> list[dict]:
-    """Plane-strain compression with linear hardening to 5 % height in 5 increments (small enough for small
-    strain to be a fair comparison), small strain against updated-Lagrangian, at growing mesh sizes."""
-    path = WORKFLOWS / "ul-compression.toml"
-    sizes = [0.04] if quick else [0.04, 0.02, 0.01]
+    """Plane-strain compression (2D) and uniaxial tension of a cube (3D) with linear hardening to 5 % in 5
+    increments (small enough for small strain to be a fair comparison), small strain against
+    updated-Lagrangian, at growing mesh sizes."""
+    cases = [("2d", "ul-compression.toml", h) for h in ([0.04] if quick else [0.04, 0.02, 0.01])]
+    cases += [("3d", "ul-tension-3d.toml", h) for h in ([0.25] if quick else [0.25, 0.125])]
     rows = []
-    for h in sizes:
-        row = {"h": h}
+    for dim, name, h in cases:
+        path = WORKFLOWS / name
+        row = {"case": dim, "h": h}
         for kind in ("small-strain", "updated-lagrangian"):
             scene = load(path)
             scene.geometry.h = h
             scene.kinematics.kind = kind
             scene.loading.steps = 5
-            scene.boundary["top"].uy = -0.05
+            if dim == "2d":
+                scene.boundary["top"].uy = -0.05
+            else:
+                scene.boundary["top"].uz = 0.05
             scene.output.png = False
             scene.output.vtu = False
-            out = workdir / f"h{h:g}-{kind}"
+            out = workdir / f"{dim}-h{h:g}-{kind}"
             shutil.rmtree(out, ignore_errors=True)
             runmod.run_scene(scene, path, out, progress=lambda *_: None)
             s = json.loads((out / "summary.json").read_text())

@@ -176,7 +176,8 @@ class Numerics(Strict):
 
 class Kinematics(Strict):
     """Small strain on the mesh of the last remesh, or updated-Lagrangian large deformation
-    (edp/lib/kinematics.idp: incremental logarithmic strain, polar rotation of the increment; 2D plane strain, P1)."""
+    (edp/lib/kinematics.idp: incremental logarithmic strain, polar rotation of the increment; 2D plane strain or
+    3D, P1)."""
 
     kind: KinematicsName = Field("small-strain", description=f"one of {', '.join(KINEMATICS)}")
     min_area_ratio: float = Field(0.02, ge=0, lt=1, description="updated-Lagrangian: an increment that shrinks "
