@@ -13,8 +13,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from wendel import output
-from wendel.run import run
+from wendel.loop import run
+from wendel.results import vtu as output
 
 from conftest import WORKFLOWS
 
