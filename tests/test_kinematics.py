@@ -74,27 +74,32 @@ def material_point(loads, axis: int, E: float, nu: float, sigma0: float, H: floa
     return out
 
 
-def test_rigid_rotation_of_a_prestressed_block(scene_file, tmp_path, quiet):
-    """90 degrees in 20 increments: the strain and stress tensors rotate with the body, their invariants
-    stay (1e-8 relative), the points are the rotated ones."""
-    root = run(WORKFLOWS / "ul-rotation.toml", out=tmp_path / "rot", progress=quiet, png=False)
-    e0 = np.array([[1e-3, 3e-4], [3e-4, -2e-4]])
+@pytest.mark.parametrize("scene, steps, dim", [("ul-rotation.toml", 20, 2), ("ul-rotation-3d.toml", 10, 3)])
+def test_rigid_rotation_of_a_prestressed_block(tmp_path, quiet, scene, steps, dim):
+    """90 degrees (2D square; 3D cube about z): the strain and stress tensors rotate with the body, their
+    invariants stay (1e-8 relative), the points are the rotated ones."""
+    root = run(WORKFLOWS / scene, out=tmp_path / "rot", progress=quiet, png=False)
+    e0 = np.zeros((3, 3))
+    e0[:2, :2] = [[1e-3, 3e-4], [3e-4, -2e-4]]
     incs = increments(root)
-    assert len(incs) == 20
+    assert len(incs) == steps
     first = incs[0][1]
     inv0 = [(first["stress_xx"] + first["stress_yy"] + first["stress_zz"]).mean(), first["vonMises"].mean()]
+    comps = {"xx": (0, 0), "yy": (1, 1), "xy": (0, 1)}
+    if dim == 3:
+        comps.update({"zz": (2, 2), "xz": (0, 2), "yz": (1, 2)})
     for rec, cells, nodes in incs:
         th = rec["load_factor"] * math.pi / 2
-        R = np.array([[math.cos(th), -math.sin(th)], [math.sin(th), math.cos(th)]])
+        R = np.array([[math.cos(th), -math.sin(th), 0], [math.sin(th), math.cos(th), 0], [0, 0, 1]])
         e = R @ e0 @ R.T
-        for key, (i, j) in {"strain_xx": (0, 0), "strain_yy": (1, 1), "strain_xy": (0, 1)}.items():
-            assert np.abs(cells[key] - e[i, j]).max() < 1e-12, (rec["increment"], key)
+        for key, (i, j) in comps.items():
+            assert np.abs(cells[f"strain_{key}"] - e[i, j]).max() < 1e-12, (rec["increment"], key)
         trace = cells["stress_xx"] + cells["stress_yy"] + cells["stress_zz"]
         assert np.abs(trace / inv0[0] - 1).max() < 1e-8
         assert np.abs(cells["vonMises"] / inv0[1] - 1).max() < 1e-8
-        pos = nodes["position"].reshape(-1, 2)
-        X = pos - nodes["u_total"].reshape(-1, 2)
-        assert np.abs(pos - X @ R.T).max() < 1e-12
+        pos = nodes["position"].reshape(-1, dim)
+        X = pos - nodes["u_total"].reshape(-1, dim)
+        assert np.abs(pos - X @ R[:dim, :dim].T).max() < 1e-12
     assert inv0[1] > 1e8            # the prestress is there (Pa)
 
 

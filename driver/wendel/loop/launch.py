@@ -95,8 +95,6 @@ def write_tables(scene: Scene, files: RunFiles, dimension: int) -> None:
     for name, b in scene.boundary.items():
         lab = LABELS[name]
         if b.motion:
-            if dimension != 2:
-                raise ValueError(f"boundary.{name}.rotation/gradient: prescribed motions are 2D only")
             g = b.gradient or [0.0] * 4
             motion.append(f"{lab} " + " ".join(repr(float(v)) for v in [b.rotation or 0.0, *g, *b.center]))
         for comp, val in enumerate((b.ux, b.uy, b.uz)):

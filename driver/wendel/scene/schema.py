@@ -95,10 +95,11 @@ class Boundary(Strict):
     uz: Optional[float] = Field(None, description="prescribed z displacement at load factor 1 [m]")
     traction: Optional[list[float]] = Field(None, description="traction vector at load factor 1 [Pa]")
     pressure: Optional[float] = Field(None, description="normal pressure at load factor 1 [Pa]")
-    rotation: Optional[float] = Field(None, description="2D prescribed motion: rigid rotation about `center` "
-                                      "at load factor 1 (angle grows linearly with it) [rad]")
-    gradient: Optional[list[float]] = Field(None, description="2D prescribed motion: displacement gradient "
-                                            "[gxx, gxy, gyx, gyy] about `center` at load factor 1 [1]")
+    rotation: Optional[float] = Field(None, description="prescribed motion: rigid rotation in the x-y plane "
+                                      "about `center` (3D: about the z axis, u_z = 0) at load factor 1 (the "
+                                      "angle grows linearly with it) [rad]")
+    gradient: Optional[list[float]] = Field(None, description="prescribed motion: in-plane displacement "
+                                            "gradient [gxx, gxy, gyx, gyy] about `center` at load factor 1 [1]")
     center: list[float] = Field([0.0, 0.0], description="centre of the prescribed motion [m]")
 
     @field_validator("traction")
