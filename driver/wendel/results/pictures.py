@@ -35,7 +35,7 @@ def picture(vtu: Path, png: Path, title: str, warp: float = 0.0, field: str | No
         if deformed:
             scale = 0.0         # updated-Lagrangian VTU: the points are the deformed body already
         grid = grid.warp_by_vector("u", factor=scale)
-        title = f"{title} (displacement x{scale:.3g})"
+        title = f"{title} ({'current configuration' if deformed else f'displacement x{scale:.3g}'})"
     field = field or ("vonMises" if "vonMises" in grid.cell_data else None)
     plotter = pv.Plotter(off_screen=True, window_size=(900, 700))
     plotter.add_mesh(grid, scalars=field, show_edges=grid.n_cells < 20000, cmap="viridis",
