@@ -216,3 +216,21 @@ def test_failed_run_reports_the_bracket(tmp_path, scene_file, capsys):
     assert "between load factor 0 (last converged) and 0.5 (first failed)" in capsys.readouterr().err
     stopped = json.loads((tmp_path / "r" / "summary.json").read_text())["stopped"]
     assert stopped["last_converged_load_factor"] == 0.0 and stopped["first_failed_load_factor"] == 0.5
+
+
+@pytest.mark.parametrize("content, words", [
+    (b"\x89PNG\r\n\x1a\n" + b"0" * 64, "is not a PGM or PPM image"),
+    (b"P2\n100000 100000\n255\n1 2 3\n", "is 100000 x 100000 pixels"),
+    (b"P2\n# only a comment\n", "unreadable PGM/PPM header"),
+])
+def test_heightmap_images_are_checked(content, words, tmp_path, capsys):
+    image = tmp_path / "map.pgm"
+    image.write_bytes(content)
+    text = (WORKFLOWS / "stamp-indent.toml").read_text()
+    start = text.index("image = ")
+    text = text[:start] + f'image = "{image}"' + text[text.index("\n", start):]
+    scene = tmp_path / "stamp.toml"
+    scene.write_text(text)
+    assert main(["check", str(scene)]) == 2
+    err = capsys.readouterr().err
+    assert f"{scene}: contact" in err and "contact.image" in err and words in err, err

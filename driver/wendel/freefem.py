@@ -80,17 +80,19 @@ _CURRENT = re.compile(r"current line = (\d+)")
 _EXEC = re.compile(r"(Exec error : .*|Compile error : .*|Load error : .*|.*Error.*)")
 
 
-def _project_file(name: str) -> str | None:
-    """``name`` if it is one of the project's .edp/.idp files (absolute, or relative to edp/), else None:
-    a path printed in the log by anything else (a run folder named like an error) is not a location."""
+def _project_file(name: str, script: Path) -> str | None:
+    """``name`` if it is an existing .edp/.idp file of the project (edp/) or beside the entry script run,
+    else None: a path printed in the log by anything else (a run folder named like an error message) is
+    not a location."""
     path = Path(name)
-    full = path if path.is_absolute() else EDP / path
-    try:
-        full = full.resolve()
-    except OSError:
-        return None
-    if full.suffix in (".edp", ".idp") and full.is_relative_to(EDP.resolve()) and full.is_file():
-        return name
+    for root in (EDP, script.parent):
+        full = path if path.is_absolute() else root / path
+        try:
+            full = full.resolve()
+        except OSError:
+            continue
+        if full.suffix in (".edp", ".idp") and full.is_relative_to(root.resolve()) and full.is_file():
+            return name
     return None
 
 
@@ -105,7 +107,7 @@ def explain_log(text: str, script: Path) -> tuple[str, str | None, int | None]:
     for m in _COMPILE.finditer(text):
         line, file, token = int(m.group(1)), m.group(2).strip(), m.group(3).strip()
         file = file.split(" in ")[-1] if file.startswith("macro:") else file
-        if _project_file(file) is None:
+        if _project_file(file, script) is None:
             continue
         after = text[m.end():].strip().splitlines()
         what = after[0].strip() if after else "compile error"
@@ -167,7 +169,7 @@ def run(entry: str, options: list[str], out_dir: Path, ranks: int = 1, timeout: 
     if (out_dir / "error.txt").is_file():
         raise FreeFemError((out_dir / "error.txt").read_text().strip(), str(script), None, log)
     text = log.read_text(errors="replace")
-    text = text[text.rfind("$ mpirun"):]
+    text = text[text.rfind("$ " + " ".join(cmd)):]       # this launch's part of the log
     message, file, line = explain_log(text, script)
     raise FreeFemError(f"FreeFEM error (exit code {rc}) in {message}\n(full log: {log})", file, line, log)
 
