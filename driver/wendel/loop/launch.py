@@ -61,8 +61,8 @@ def options(scene: Scene, files: RunFiles, dimension: int, segment: dict | None 
     opts += ["-mat_E", repr(m.E), "-mat_nu", repr(m.nu),
              "-el_plane_stress", "1" if scene.elasticity.plane == "stress" else "0",
              "-bc", str(files.tables / "bc.txt"), "-trac", str(files.tables / "trac.txt")]
-    for key in ("ubase", "eps0"):
-        if segment.get(key):
+    for key in ("ubase", "eps0"):      # updated Lagrangian: the strain is state (ul_eps.qp.txt), no pre-strain
+        if segment.get(key) and not (key == "eps0" and scene.kinematics.updated_lagrangian):
             opts += [f"-{key}", str(files.root / segment[key])]
     if (files.tables / "motion.txt").is_file():
         opts += ["-bc_motion", str(files.tables / "motion.txt")]
