@@ -23,8 +23,9 @@ from conftest import WORKFLOWS
 
 GUARDS = {"plasticity": "wendelPlasticityIdp", "contact": "wendelContactIdp", "thermal": "wendelThermalIdp",
           "thermal-fields": "wendelThermalFieldsIdp", "elasticity": "wendelElasticityIdp",
+          "axisymmetric": "wendelAxisymmetricIdp", "axisymmetric-mechanics": "wendelAxisymmetricMechanicsIdp",
           "kinematics": "wendelKinematicsIdp"}
-MODULES = ("plasticity", "contact", "thermal", "thermal-fields", "kinematics")
+MODULES = ("plasticity", "contact", "thermal", "thermal-fields", "axisymmetric", "axisymmetric-mechanics", "kinematics")
 
 
 def compiled(tmp_path, scene_name: str) -> tuple[set[str], list[str], dict]:

@@ -8,7 +8,6 @@ the progress lines in :mod:`.progress`, the remesh step in :mod:`wendel.remesh.s
 from __future__ import annotations
 
 import contextlib
-import errno
 import json
 import shutil
 import tempfile
@@ -16,14 +15,15 @@ import time
 from pathlib import Path
 
 from .. import freefem
-from ..errors import DiskFull, Interrupted, RunFolderError
+from ..errors import DiskFull, RunFolderError
 from ..meshes import build as build_mesh
 from ..remesh.step import finish_report, judge, maybe_remesh
 from ..results import pictures, summary, vtu
 from ..scene import load
 from ..scene.reading import check_size
 from ..scene.schema import Scene
-from .checkpoint import RunFiles, State, load_state, save as _save_checkpoint
+from .checkpoint import RunFiles, State, committed, load_state, save as _save_checkpoint
+from .guard import disk_full as _disk_full, guarded
 from .launch import entry_script, macros, options, write_tables
 from .progress import _Progress
 from .steps import cut_step, grow_step, plan_step
@@ -85,34 +85,6 @@ def run_scene(scene: Scene, scene_path: Path, out: Path, smoke: bool = False, pr
         state.mesh_seconds, dimension = build(scene, files)
         _save_checkpoint(files, scene, state, dimension)
         return _execute(scene, files, state, progress)
-
-
-@contextlib.contextmanager
-def guarded(root: Path):
-    """Name the run folder when a run stops short: Ctrl-C or SIGTERM (FreeFEM is stopped with the driver)
-    becomes :class:`Interrupted`, a full disk (of the driver's files or FreeFEM's) :class:`DiskFull`."""
-    try:
-        yield
-    except Interrupted:
-        raise
-    except KeyboardInterrupt:
-        raise Interrupted(root) from None
-    except OSError as exc:
-        if exc.errno == errno.ENOSPC:
-            raise DiskFull(root) from None
-        raise
-    except (freefem.FreeFemError, ValueError):
-        if _disk_full(root):
-            raise DiskFull(root) from None
-        raise
-
-
-def _disk_full(root: Path) -> bool:
-    """Whether the file system of ``root`` has (almost) no room left for another increment."""
-    try:
-        return shutil.disk_usage(root).free < 64 * 1024
-    except OSError:
-        return False
 
 
 def _execute(scene: Scene, files: RunFiles, state: State, progress) -> Path:
@@ -231,19 +203,6 @@ def _reequilibrated(files: RunFiles, state: State, progress) -> None:
                   files.root / "remesh" / f"remesh-{len(state.remeshes)}.json")
     progress(f"  re-equilibrated on the new mesh: relative residual {rep['residual_after_transfer']:.2e}"
              f" -> {rep['residual_after_reequilibration']:.2e}")
-
-
-def committed(inc_dir: Path) -> dict | None:
-    """The record of increment folder ``inc_dir`` if FreeFEM committed it whole (its `done` marker, a
-    readable record.json and every array file complete), else None."""
-    if not (inc_dir / "done").is_file():
-        return None
-    try:
-        record = json.loads((inc_dir / "record.json").read_text())
-    except (OSError, ValueError):
-        return None
-    arrays = [p for p in inc_dir.glob("*.txt")]
-    return record if all(vtu.complete_array(p) for p in arrays) else None
 
 
 def accept(scene: Scene, files: RunFiles, state: State, dimension: int) -> None:

@@ -45,10 +45,11 @@ def _freefem_version() -> str:
 
 def write_provenance(root: Path, scene_path: Path, scene, smoke: bool) -> None:
     """The scene as run and where it ran: commit, versions, command line, host, start time."""
-    shutil.copyfile(scene_path, root / "scene.toml")
-    tmp = root / "scene.resolved.json.tmp"      # atomic: a run stopped before its checkpoint restarts from it
+    # first and atomically: a run stopped before its first checkpoint restarts from it (wendel run --resume)
+    tmp = root / "scene.resolved.json.tmp"
     tmp.write_text(json.dumps(scene.model_dump(mode="json"), indent=1))
     os.replace(tmp, root / "scene.resolved.json")
+    shutil.copyfile(scene_path, root / "scene.toml")
     versions = {"wendel": __version__, "python": sys.version.split()[0], "freefem++": _freefem_version()}
     for pkg in ("gmsh", "meshio", "numpy", "scipy", "pydantic", "pyvista", "matplotlib"):
         try:
