@@ -120,19 +120,23 @@ def _solve_and_report(scene: Scene, files: RunFiles, state: State, dimension: in
         inc, lf = state.last
         if scene.output.vtu:
             painter.paint(files.vtu / f"inc-{inc:04d}.vtu", files.root / "deformed.png", f"load factor {lf:g}",
-                          scene.output.warp)
+                          scene.output.warp, deformed=scene.kinematics.updated_lagrangian)
         else:            # no VTU series: the picture is made from a VTU of the last increment that is not kept
             with tempfile.TemporaryDirectory() as tmp:
-                _write_increment_vtu(files, state, dimension, inc, Path(tmp) / "last.vtu")
+                _write_increment_vtu(files, state, dimension, inc, Path(tmp) / "last.vtu",
+                                     scene.kinematics.updated_lagrangian)
                 painter.paint(Path(tmp) / "last.vtu", files.root / "deformed.png", f"load factor {lf:g}",
-                              scene.output.warp)
+                              scene.output.warp, deformed=scene.kinematics.updated_lagrangian)
         summary.write_summary(files.root, scene, state, dimension, picture=time.perf_counter() - t0)
 
 
-def _write_increment_vtu(files: RunFiles, state: State, dimension: int, inc: int, path: Path) -> None:
+def _write_increment_vtu(files: RunFiles, state: State, dimension: int, inc: int, path: Path,
+                         updated_lagrangian: bool = False) -> None:
     """The VTU of accepted increment ``inc`` at ``path``."""
     points, cells = vtu.read_mesh(files.root / state.segment(inc)["mesh"], dimension)
     pdata, cdata = vtu.increment_fields(files.fem / f"inc-{inc:04d}", len(points), len(cells), dimension)
+    if updated_lagrangian:      # the VTU is the deformed body itself (points = current positions)
+        points = vtu.current_points(pdata, points)
     vtu.write_vtu(path, points, cells, dimension, pdata, cdata)
 
 
@@ -243,7 +247,9 @@ def accept(scene: Scene, files: RunFiles, state: State, dimension: int) -> None:
         if scene.output.vtu:
             pdata, cdata = vtu.increment_fields(d, len(points), len(cells), dimension)
             files.vtu.mkdir(exist_ok=True)
-            vtu.write_vtu(files.vtu / f"inc-{inc:04d}.vtu", points, cells, dimension, pdata, cdata)
+            # updated-Lagrangian: the VTU is the deformed body itself (points = current positions)
+            at = vtu.current_points(pdata, points) if scene.kinematics.updated_lagrangian else points
+            vtu.write_vtu(files.vtu / f"inc-{inc:04d}.vtu", at, cells, dimension, pdata, cdata)
         state.accepted.append((inc, record["load_factor"]))
         state.pending.pop(0)
         summary.append_history(files.root, {**record, **extra}, d / "newton.csv")
