@@ -84,6 +84,28 @@ def test_sliding_block_tresca_slides_at_the_bound(tmp_path):
     assert all(r[k] < 1e-8 for r in recs for k in KKT)
 
 
+def test_incline_pull_at_which_sliding_starts(tmp_path):
+    # A block on a 10 deg incline under gravity (rho g = 1e5 N/m^3 times the load factor), its top held by a
+    # frictionless horizontal guide; from load factor 1 on the incline slides down the slope. The guide's
+    # horizontal pull R (= -contact force x by equilibrium) grows while the block sticks and reaches
+    # W tan(alpha + atan(mu)) when every node slides (closed form of the rigid block: 1e-8 relative).
+    root = run(WORKFLOWS / "incline.toml", out=tmp_path / "inc", png=False, progress=lambda *_: None)
+    recs = records(root)
+    alpha, mu = math.radians(10.0), 0.3
+    closed = math.tan(alpha + math.atan(mu))
+    ratios = []
+    for r in recs:
+        weight = r["load_factor"] * 1.0e5 * 0.5            # N/m: rho g times the block's area 1 m x 0.5 m
+        assert r["contact_force_y"] == pytest.approx(weight, rel=1e-9)
+        ratios.append(-r["contact_force_x"] / weight)
+        assert all(r[k] < 1e-8 for k in KKT), {k: r[k] for k in KKT}
+    stick = [q for q, r in zip(ratios, recs) if r["friction_stick_nodes"] > 0]
+    slide = [q for q, r in zip(ratios, recs) if r["friction_stick_nodes"] == 0]
+    assert stick and len(slide) >= 5
+    assert all(q < closed * (1 - 1e-3) for q in stick), (stick, closed)
+    assert all(q == pytest.approx(closed, rel=1e-8) for q in slide), (slide, closed)
+
+
 def test_bad_friction_input_is_named(tmp_path):
     from wendel.scene import load
 
