@@ -106,6 +106,18 @@ def test_incline_pull_at_which_sliding_starts(tmp_path):
     assert all(q == pytest.approx(closed, rel=1e-8) for q in slide), (slide, closed)
 
 
+def test_punch_with_an_edge_radius_matches_hertz(tmp_path):
+    # The wedge's rounded tip (R = 1 m) against the block of the Hertz scene, gap and normal from the tool's
+    # signed distance in the current configuration: the tolerances of the ball's Hertz test (5%; measured
+    # 1.1% contact half-width, 0.2% peak pressure; the ball: 1.6% and 0.7%).
+    root = run(WORKFLOWS / "punch.toml", out=tmp_path / "punch", png=False, progress=lambda *_: None)
+    last = json.loads((root / "summary.json").read_text())["last_increment"]
+    assert last["error_contact_size"] < 0.05 and last["error_max_pressure"] < 0.05
+    assert all(last[k] < 1e-8 for k in KKT), {k: last[k] for k in KKT}
+    assert last["contact_active_nodes"] > 10
+    assert abs(last["contact_min_gap_undeformed"]) < 1e-12      # the tip touches the block at load factor 0
+
+
 def test_bad_friction_input_is_named(tmp_path):
     from wendel.scene import load
 
