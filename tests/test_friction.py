@@ -118,6 +118,22 @@ def test_punch_with_an_edge_radius_matches_hertz(tmp_path):
     assert abs(last["contact_min_gap_undeformed"]) < 1e-12      # the tip touches the block at load factor 0
 
 
+def test_hertz_at_a_prescribed_force_in_one_run(tmp_path):
+    # Force control: the cylinder's position is a Newton unknown (bordered system: the step at a fixed tool
+    # and the response to a unit tool motion); one run reaches 1e7 N/m, and the contact size is within the
+    # Hertz test's 5% (measured 0.24% half-width, 0.18% peak pressure).
+    root = run(WORKFLOWS / "hertz-force.toml", out=tmp_path / "hf", png=False, progress=lambda *_: None)
+    s = json.loads((root / "summary.json").read_text())
+    last = s["last_increment"]
+    assert s["increments"] == 1 and s["step_cuts"] == 0
+    assert last["pressing_force"] == pytest.approx(1.0e7, rel=1e-8) and last["error_force"] < 1e-8
+    assert last["error_contact_size"] < 0.05 and last["error_max_pressure"] < 0.05
+    assert all(last[k] < 1e-8 for k in KKT)
+    assert -0.03 < last["tool_position"] < -0.01                    # moved from its first guess (-0.01 m)
+    with open(root / "history.csv") as f:
+        assert {"tool_position", "pressing_force", "force_target"} <= set(next(csv.DictReader(f)))
+
+
 def test_bad_friction_input_is_named(tmp_path):
     from wendel.scene import load
 

@@ -146,6 +146,9 @@ class Contact(BaseModel):
     friction: Optional[Friction] = Field(None, description="friction law (2D; absent: frictionless)")
     tool: Optional[Tool] = Field(None, description="obstacle = 'tool': the polygon with rounded corners (2D)")
     path: Optional[ToolPath] = Field(None, description="the obstacle's motion along the load factor (2D)")
+    force: Optional[float] = Field(None, gt=0, description="force control: the pressing force along the normal axis at load "
+                                   "factor 1 [N/m in 2D]; the tool's position along that axis is solved for (displacement = first guess) (2D)")
+    force_tol: float = Field(1e-9, gt=0, lt=1e-2, description="force control: relative tolerance on the force [1]")
 
 
     @field_validator("normal")
@@ -180,7 +183,7 @@ class Contact(BaseModel):
     @property
     def current_configuration(self) -> bool:
         """Friction, a tool or a path: edp/lib/friction.idp (gap and normal in the current configuration)."""
-        return self.friction is not None or self.tool is not None or self.path is not None
+        return self.friction is not None or self.tool is not None or self.path is not None or self.force is not None
 
     @property
     def image_path(self) -> Path:
@@ -212,6 +215,8 @@ def friction_options(block: Contact, files) -> list[str]:
     f = block.friction or Friction(law="none")
     opts = ["-DWITHFRICTION=1", "-fric_law", str(FRICTION_LAWS[f.law]), "-fric_mu", repr(f.mu),
             "-fric_tau", repr(f.tau_max or 0.0), "-fric_c", repr(f.c), "-fric_heat_fraction", repr(f.heat_fraction)]
+    if block.force is not None:
+        opts += ["-tool_force", repr(block.force), "-tool_force_tol", repr(block.force_tol)]
     if files is None:
         return opts
     files.tables.mkdir(parents=True, exist_ok=True)
