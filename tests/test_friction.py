@@ -134,6 +134,21 @@ def test_hertz_at_a_prescribed_force_in_one_run(tmp_path):
         assert {"tool_position", "pressing_force", "force_target"} <= set(next(csv.DictReader(f)))
 
 
+def test_frictional_heat_enters_the_body_by_its_fraction(tmp_path):
+    # The sliding block with an insulated heat equation: the contact heat that entered the body equals
+    # heat_fraction x frictional work, and the heat stored in the block (rho c int dT) equals it: 1e-6.
+    root = run(WORKFLOWS / "sliding-heat.toml", out=tmp_path / "sh", png=False, progress=lambda *_: None)
+    last = json.loads((root / "summary.json").read_text())["last_increment"]
+    work = last["friction_work"]
+    assert work > 1000                                        # J/m: about 0.3 x 2.4e5 N/m x 40 mm of slip
+    assert last["heat_contact"] == pytest.approx(0.5 * work, rel=1e-6)
+    assert last["friction_heat_tool"] == pytest.approx(0.5 * work, rel=1e-12)
+    assert last["thermal_energy_change"] == pytest.approx(0.5 * work, rel=1e-6)
+    assert last["energy_balance_error"] < 1e-6
+    assert last["max_temperature"] > 293.15 + 0.05             # K: the contact face warms up
+    assert all(last[k] < 1e-8 for k in KKT)
+
+
 def test_bad_friction_input_is_named(tmp_path):
     from wendel.scene import load
 
