@@ -158,3 +158,16 @@ def test_bad_friction_input_is_named(tmp_path):
     scene = variant(tmp_path, "sliding-block", {'law = "coulomb"': 'law = "amontons"'})
     with pytest.raises(Exception, match="coulomb"):
         load(scene)
+
+
+def test_friction_bench_at_smoke_sizes(tmp_path):
+    from wendel.bench import BENCHES, bench
+
+    root = bench(["friction"], quick=True, out=tmp_path / "bench", progress=lambda *_: None)
+    assert "friction" in BENCHES
+    rows = json.loads((root / "friction.json").read_text())["rows"]
+    assert len(rows) == 6 and all(r["newton_iterations"] >= r["increments"] for r in rows)
+    by = {(r["scene"], r["variant"].split(" (")[0]): r for r in rows}
+    assert by[("sliding-block", "Coulomb mu = 0.3")]["friction_ratio"] == pytest.approx(0.3, rel=1e-8)
+    # friction costs Newton iterations, but not many more than the frictionless solve (measured 1.5x on Hertz)
+    assert by[("hertz", "Coulomb mu = 0.3")]["iterations_vs_frictionless"] <= 2.0
