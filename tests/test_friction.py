@@ -134,6 +134,28 @@ def test_hertz_at_a_prescribed_force_in_one_run(tmp_path):
         assert {"tool_position", "pressing_force", "force_target"} <= set(next(csv.DictReader(f)))
 
 
+def test_scratch_large_sliding_of_a_rounded_wedge(tmp_path):
+    # The wedge (edge radius 0.5 m) pressed 10 mm, then dragged 0.4 m, eight contact widths: the contact
+    # follows the tool (gap and normal recomputed in the current configuration every Newton iteration)
+    # and every active node slides at lambda_t = -mu lambda_n.
+    root = run(WORKFLOWS / "scratch.toml", smoke=True, out=tmp_path / "scr", png=False, progress=lambda *_: None)
+    recs = records(root)
+    assert [r["load_factor"] for r in recs] == pytest.approx([0.25 * k for k in range(1, 9)])
+    for r in recs:
+        assert all(r[k] < 1e-8 for k in KKT), {k: r[k] for k in KKT}
+        assert r["contact_active_nodes"] >= 5
+    for r in recs[4:]:
+        assert r["friction_stick_nodes"] == 0
+        assert abs(r["friction_force"]) == pytest.approx(0.2 * r["normal_force"], rel=1e-8)
+    assert recs[-1]["tool_x"] == pytest.approx(0.4)
+    from wendel import output
+
+    pts = output.read_vertices(root / "fem" / "vertices.txt")
+    active = output.read_array(root / "fem" / "inc-0008" / "contact_active.node.txt") > 0.5
+    centre = pts[active, 0].mean()
+    assert centre == pytest.approx(0.4, abs=0.03)          # m: the contact zone moved with the tool
+
+
 def test_frictional_heat_enters_the_body_by_its_fraction(tmp_path):
     # The sliding block with an insulated heat equation: the contact heat that entered the body equals
     # heat_fraction x frictional work, and the heat stored in the block (rho c int dT) equals it: 1e-6.
