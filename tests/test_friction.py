@@ -84,6 +84,22 @@ def test_sliding_block_tresca_slides_at_the_bound(tmp_path):
     assert all(r[k] < 1e-8 for r in recs for k in KKT)
 
 
+def test_one_and_two_ranks_agree(tmp_path):
+    # Every rank holds the whole frictional system (its sets are the same on every rank); ffddm's GMRES
+    # solves the non-symmetric Newton matrix on 2 ranks.
+    recs = {}
+    for np in (1, 2):
+        root = run(WORKFLOWS / "sliding-block.toml", smoke=True, ranks=np, out=tmp_path / f"np{np}", png=False,
+                   progress=lambda *_: None)
+        recs[np] = records(root)
+    assert recs[2][-1]["ranks"] == 2 and recs[2][-1]["solver"] == "ffddm"
+    assert [r["newton_iterations"] for r in recs[1]] == [r["newton_iterations"] for r in recs[2]]
+    for a, b in zip(recs[1], recs[2]):
+        assert b["friction_force"] == pytest.approx(a["friction_force"], rel=1e-8)
+        assert b["normal_force"] == pytest.approx(a["normal_force"], rel=1e-8)
+        assert b["friction_stick_nodes"] == a["friction_stick_nodes"]
+
+
 def test_incline_pull_at_which_sliding_starts(tmp_path):
     # A block on a 10 deg incline under gravity (rho g = 1e5 N/m^3 times the load factor), its top held by a
     # frictionless horizontal guide; from load factor 1 on the incline slides down the slope. The guide's
