@@ -196,6 +196,18 @@ def test_bad_friction_input_is_named(tmp_path):
     scene = variant(tmp_path, "sliding-block", {'law = "coulomb"': 'law = "amontons"'})
     with pytest.raises(Exception, match="coulomb"):
         load(scene)
+    scene = variant(tmp_path, "sliding-block", {'solver = "direct"': 'solver = "cg"'})
+    with pytest.raises(Exception, match="numerics.solver"):
+        load(scene)
+    scene = variant(tmp_path, "punch", {"radii = [1.0, 0.0, 0.0]": "radii = [1.0, -1.0, 0.0]"})
+    with pytest.raises(Exception, match="radii"):
+        load(scene)
+    # the command line names the file and the key, exit code 2, no traceback
+    import subprocess
+    import sys
+
+    proc = subprocess.run([sys.executable, "-m", "wendel.cli", "check", str(scene)], capture_output=True, text=True)
+    assert proc.returncode == 2 and "radii" in proc.stderr + proc.stdout and "Traceback" not in proc.stderr
 
 
 def test_friction_bench_at_smoke_sizes(tmp_path):

@@ -234,7 +234,14 @@ def friction_options(block: Contact, files) -> list[str]:
     return opts
 
 
-register(Block(name="contact", model=Contact, options=options,
+def _check(block: Contact, scene) -> None:
+    """Scene-level rules of friction.idp: a non-symmetric Newton matrix (no CG)."""
+    if block.current_configuration and scene.numerics.solver == "cg":
+        raise ValueError("contact.friction/tool/path/force give a non-symmetric Newton matrix: "
+                         "numerics.solver must be 'direct' or 'ffddm', not 'cg'")
+
+
+register(Block(name="contact", model=Contact, options=options, check=_check,
                fields=("contact_pressure", "contact_active", "contact_gap", "friction_traction", "friction_slip",
                        "friction_state")))
 
