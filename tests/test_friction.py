@@ -187,6 +187,25 @@ def test_frictional_heat_enters_the_body_by_its_fraction(tmp_path):
     assert all(last[k] < 1e-8 for k in KKT)
 
 
+def test_capped_coulomb_slides_at_min_of_mu_p_and_the_cap(tmp_path):
+    # Coulomb with a cap on the shear traction (cutting models): sliding nodes carry min(mu p, tau_max).
+    from wendel import output
+
+    tau, mu = 6.0e4, 0.3
+    scene = variant(tmp_path, "sliding-block", {
+        'friction = { law = "coulomb", mu = 0.3 }': f'friction = {{ law = "coulomb", mu = {mu}, tau_max = {tau} }}'})
+    root = run(scene, out=tmp_path / "cap", png=False, progress=lambda *_: None)
+    recs = records(root)
+    assert recs[-1]["friction_stick_nodes"] == 0 and all(r[k] < 1e-8 for r in recs for k in KKT)
+    d = root / "fem" / "inc-0011"
+    p = output.read_array(d / "contact_pressure.node.txt")
+    t = output.read_array(d / "friction_traction.node.txt")
+    active = output.read_array(d / "contact_active.node.txt") > 0.5
+    bound = np.minimum(mu * p[active], tau)
+    assert np.abs(np.abs(t[active]) - bound).max() <= 1e-8 * tau
+    assert (mu * p[active] > tau).sum() >= 3 and (mu * p[active] < tau).sum() >= 3    # both branches present
+
+
 def test_bad_friction_input_is_named(tmp_path):
     from wendel.scene import load
 
