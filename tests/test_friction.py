@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from wendel.run import run
+from wendel.loop import run
 
 from conftest import WORKFLOWS
 
@@ -164,7 +164,7 @@ def test_scratch_large_sliding_of_a_rounded_wedge(tmp_path):
         assert r["friction_stick_nodes"] == 0
         assert abs(r["friction_force"]) == pytest.approx(0.2 * r["normal_force"], rel=1e-8)
     assert recs[-1]["tool_x"] == pytest.approx(0.4)
-    from wendel import output
+    from wendel.results import vtu as output
 
     pts = output.read_vertices(root / "fem" / "vertices.txt")
     active = output.read_array(root / "fem" / "inc-0008" / "contact_active.node.txt") > 0.5
@@ -189,7 +189,7 @@ def test_frictional_heat_enters_the_body_by_its_fraction(tmp_path):
 
 def test_capped_coulomb_slides_at_min_of_mu_p_and_the_cap(tmp_path):
     # Coulomb with a cap on the shear traction (cutting models): sliding nodes carry min(mu p, tau_max).
-    from wendel import output
+    from wendel.results import vtu as output
 
     tau, mu = 6.0e4, 0.3
     scene = variant(tmp_path, "sliding-block", {

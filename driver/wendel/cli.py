@@ -45,7 +45,7 @@ def main(argv: list[str] | None = None) -> int:
 
     args = parser.parse_args(argv)
     from .freefem import FreeFemError, NewtonFailure
-    from .run import StepCutError
+    from .loop import StepCutError
     from .scene import SceneError
     try:
         if args.command == "check":
@@ -55,19 +55,19 @@ def main(argv: list[str] | None = None) -> int:
                 print(f"{s}: ok ({scene.description}; blocks: {', '.join(scene.blocks) or 'elastic'})")
             return 0
         if args.command == "run":
-            from .run import run
+            from .loop import run
             if args.resume is None and args.scene is None:
                 parser.error("run needs a scene file or --resume RUN_DIR")
             root = run(args.scene or "", smoke=args.smoke, ranks=args.np, out=args.out, resume=args.resume)
             _print_summary(root)
             return 0
         if args.command == "study":
-            from .study import study
+            from .results.study import study
             root = study(args.scene, levels=args.levels, smoke=args.smoke, ranks=args.np, out=args.out)
             print(f"study written to {root}")
             return 0
         if args.command == "keys":
-            from .schema import keys_table, update_readme
+            from .scene.schema import keys_table, update_readme
             if args.update:
                 print(f"{args.update}: {'updated' if update_readme(args.update) else 'up to date'}")
             else:

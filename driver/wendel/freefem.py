@@ -1,7 +1,9 @@
 """Run FreeFEM entry scripts: environment, MPI launch, time limit, log, errors turned into exceptions.
 
-Every launch is ``mpirun -np N FreeFem++-mpi -nw -v 0 edp/<entry>.edp -key value ...`` (one code path
-for 1 and N ranks; 0.16 s start on one rank here). FreeFEM's output goes to a log file; results come
+Every launch is ``mpirun -np N FreeFem++-mpi -nw -v 0 edp/<entry>.edp -out DIR -DNAME=VALUE ... -key value ...``
+(one code path for 1 and N ranks; 0.16 s start on one rank here). ``-D`` arguments define FreeFEM macros
+before the script compiles (they choose the modules, :func:`wendel.loop.launch.macros`); the others are
+read by ``getARGV`` at run time. FreeFEM's output goes to a log file; results come
 back as files (the exit code says which file to read), never scraped from stdout except to quote a
 compile or runtime error.
 """

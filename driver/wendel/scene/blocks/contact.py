@@ -1,0 +1,303 @@
+"""The ``[contact]`` block: frictionless Signorini contact with one rigid obstacle (edp/lib/contact.idp).
+
+The contact boundary is a named boundary whose outward normal is along a coordinate axis (``normal``,
+e.g. ``"+y"``); the gap is measured along that axis in the undeformed configuration. Obstacle shapes go
+through a registry of names to the integer ids of ``-contact_obstacle``:
+
+>>> sorted(OBSTACLES.items(), key=lambda kv: kv[1])
+[('plane', 1), ('ball', 2), ('cylinder', 3), ('heightmap', 4), ('tool', 5)]
+>>> Contact(boundary="top", obstacle="ball", center=[0.0, 1.0], radius=1.0).normal
+'+y'
+>>> options(Contact(boundary="top", normal="+z", displacement=-1e-3), None, None)[:6]
+['-contact_label', '4', '-contact_axis', '2', '-contact_dir', '1']
+
+Friction, a tool of any shape, a tool path or force control switch to edp/lib/friction.idp (current
+configuration, 2D) through the extra macro ``-DWITHFRICTION=1`` (wendel.loop.launch.macros):
+
+>>> c = Contact(boundary="bottom", normal="-y", friction={"law": "coulomb", "mu": 0.3})
+>>> c.current_configuration, options(c, None, None)[-10:-6]
+(True, ['-fric_law', '1', '-fric_mu', '0.3'])
+
+The scalar membrane obstacle problem (deal.II step-41, ``edp/obstacle.edp``) is the problem
+``membrane-obstacle`` with its table ``[obstacle]``:
+
+>>> MembraneObstacle(shape="radial").c
+100.0
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Optional
+
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+
+import json
+import math
+import shutil
+
+from . import Block, Problem, choice, register, register_problem
+from ...meshes import LABELS
+
+OBSTACLES = {"plane": 1, "ball": 2, "cylinder": 3, "heightmap": 4, "tool": 5}
+"""Obstacle name -> ``-contact_obstacle`` id of contact.idp."""
+REFERENCES = {"hertz": 1}
+"""Reference name -> ``-contact_ref`` id of contact.idp."""
+AXES = {"x": 0, "y": 1, "z": 2}
+
+BoundaryName = choice(LABELS, "boundary")
+ObstacleName = choice(OBSTACLES, "obstacle")
+ContactReferenceName = choice(REFERENCES, "contact reference")
+FRICTION_LAWS = {"none": 0, "coulomb": 1, "tresca": 2}
+"""Friction law name -> ``-fric_law`` id of friction.idp."""
+FrictionLawName = choice(FRICTION_LAWS, "friction law")
+ROOT = Path(__file__).resolve().parents[4]
+
+
+class Friction(BaseModel):
+    """Friction between the body and the tool (edp/lib/friction.idp): Coulomb (optionally capped in shear)
+    or Tresca, with stick, slip and inactive sets in the same semismooth Newton as the normal contact."""
+
+    model_config = ConfigDict(extra="forbid", validate_assignment=True)
+
+    law: FrictionLawName = Field("coulomb", description=f"friction law: {', '.join(FRICTION_LAWS)}")
+    mu: float = Field(0.0, ge=0, le=10, description="Coulomb friction coefficient [1]")
+    tau_max: Optional[float] = Field(None, gt=0, description="Tresca: the slip bound; Coulomb: a cap on the shear traction [Pa]")
+    c: float = Field(0.0, ge=0, description="tangential active-set constant [Pa/m]; 0 = the normal one (contact.c)")
+    heat_fraction: float = Field(1.0, ge=0, le=1, description="share of the frictional work that heats the body (the rest the tool) [1]")
+
+    @model_validator(mode="after")
+    def _law(self):
+        if self.law == "tresca" and self.tau_max is None:
+            raise ValueError("contact.friction: law = 'tresca' needs tau_max (the slip bound, Pa)")
+        if self.law == "coulomb" and self.mu == 0 and self.tau_max is None:
+            raise ValueError("contact.friction: law = 'coulomb' needs mu > 0 (or law = 'none')")
+        return self
+
+
+class Tool(BaseModel):
+    """A rigid 2D tool: a counter-clockwise polygon at load factor 0 whose corners are rounded by radii
+    (a cutting tool: rake face, flank face and the edge radius at their corner)."""
+
+    model_config = ConfigDict(extra="forbid", validate_assignment=True)
+
+    vertices: list[list[float]] = Field(..., description="polygon vertices [[x, y], ...], counter-clockwise [m]")
+    radii: Optional[list[float]] = Field(None, description="corner radius of each vertex, 0 = sharp [m]; default all 0")
+
+    @model_validator(mode="after")
+    def _shape(self):
+        v = self.vertices
+        if len(v) < 3 or any(len(p) != 2 for p in v):
+            raise ValueError("contact.tool.vertices: at least 3 points [x, y]")
+        area = sum(v[k][0] * v[(k + 1) % len(v)][1] - v[(k + 1) % len(v)][0] * v[k][1] for k in range(len(v)))
+        if not area > 0:
+            raise ValueError("contact.tool.vertices must run counter-clockwise around a non-empty polygon")
+        if self.radii is not None and (len(self.radii) != len(v) or any(r < 0 for r in self.radii)):
+            raise ValueError("contact.tool.radii: one radius >= 0 per vertex")
+        return self
+
+
+class ToolPath(BaseModel):
+    """The tool's rigid motion as piecewise-linear functions of the load factor (extrapolated linearly past
+    the ends): translation (x, y) and rotation about contact.center; added to contact.displacement."""
+
+    model_config = ConfigDict(extra="forbid", validate_assignment=True)
+
+    load_factors: list[float] = Field(..., min_length=1, description="load factors of the path points, increasing [1]")
+    x: Optional[list[float]] = Field(None, description="translation along x at those load factors [m]; default 0")
+    y: Optional[list[float]] = Field(None, description="translation along y at those load factors [m]; default 0")
+    angle: Optional[list[float]] = Field(None, description="rotation about contact.center, counter-clockwise [deg]; default 0")
+
+    @model_validator(mode="after")
+    def _lengths(self):
+        n = len(self.load_factors)
+        if any(b <= a for a, b in zip(self.load_factors, self.load_factors[1:])):
+            raise ValueError("contact.path.load_factors must increase")
+        for key in ("x", "y", "angle"):
+            val = getattr(self, key)
+            if val is not None and len(val) != n:
+                raise ValueError(f"contact.path.{key} needs {n} values (one per load factor)")
+        return self
+
+    def rows(self) -> list[tuple[float, float, float, float]]:
+        """(load factor, x, y, angle in rad) per path point."""
+        n = len(self.load_factors)
+        x, y, a = (self.x or [0.0] * n), (self.y or [0.0] * n), (self.angle or [0.0] * n)
+        return [(lf, xi, yi, math.radians(ai)) for lf, xi, yi, ai in zip(self.load_factors, x, y, a)]
+
+
+class Contact(BaseModel):
+    """A rigid obstacle pressed on a named boundary; PDAS (semismooth Newton) in the Newton loop."""
+
+    model_config = ConfigDict(extra="forbid", validate_assignment=True)
+
+    boundary: BoundaryName = Field(..., description="named contact boundary (meshes/labels.py)")
+    normal: str = Field("+y", description="outward normal of that boundary: +x, -x, +y, -y, +z or -z")
+    obstacle: ObstacleName = Field("plane", description=f"obstacle shape: {', '.join(OBSTACLES)}")
+    center: list[float] = Field([0.0, 0.0, 0.0], description="plane point, ball/cylinder centre, heightmap base and centre [m]")
+    radius: float = Field(1.0, gt=0, description="ball or cylinder radius [m]")
+    cylinder_axis: str = Field("x", description="3D cylinder axis direction: x, y or z (not the normal's)")
+    displacement: float = Field(0.0, description="obstacle displacement along the normal axis at load factor 1 [m] (signed along the axis)")
+    image: Optional[str] = Field(None, description="heightmap: PGM/PPM image, relative to the repository root; bright = closer to the body")
+    height: float = Field(0.0, ge=0, description="heightmap: protrusion of white over black towards the body [m]")
+    size: list[float] = Field([1.0, 1.0], description="heightmap: footprint along the two tangential axes [m]")
+    c: float = Field(0.0, ge=0, description="active-set constant [Pa/m]; 0 = E / h_min (the solution does not depend on it)")
+    reference: Optional[ContactReferenceName] = Field(None, description=f"reference solution: {', '.join(REFERENCES)} (contact size and peak pressure)")
+    friction: Optional[Friction] = Field(None, description="friction law (2D; absent: frictionless)")
+    tool: Optional[Tool] = Field(None, description="obstacle = 'tool': the polygon with rounded corners (2D)")
+    path: Optional[ToolPath] = Field(None, description="the obstacle's motion along the load factor (2D)")
+    force: Optional[float] = Field(None, gt=0, description="force control: the pressing force along the normal axis at load "
+                                   "factor 1 [N/m in 2D]; the tool's position along that axis is solved for (displacement = first guess) (2D)")
+    force_tol: float = Field(1e-9, gt=0, lt=1e-2, description="force control: relative tolerance on the force [1]")
+
+
+    @field_validator("normal")
+    @classmethod
+    def _normal(cls, v):
+        if len(v) != 2 or v[0] not in "+-" or v[1] not in AXES:
+            raise ValueError(f"normal must be one of +x, -x, +y, -y, +z, -z; got {v!r}")
+        return v
+
+
+
+    @model_validator(mode="after")
+    def _consistency(self):
+        if self.obstacle == "heightmap":
+            if self.image is None:
+                raise ValueError("contact.obstacle = 'heightmap' needs contact.image")
+            if not self.image_path.is_file():
+                raise ValueError(f"contact.image: no such file {self.image_path}")
+        if self.cylinder_axis not in AXES or (self.obstacle == "cylinder" and self.cylinder_axis == self.normal[1]):
+            raise ValueError("contact.cylinder_axis must be x, y or z and differ from the normal's axis")
+        if len(self.center) not in (2, 3) or len(self.size) != 2:
+            raise ValueError("contact.center has 2 or 3 components, contact.size 2")
+        if self.reference == "hertz" and self.obstacle not in ("ball", "tool"):
+            raise ValueError("contact.reference = 'hertz' needs obstacle = 'ball' or 'tool' (edge radius = contact.radius)")
+        if (self.obstacle == "tool") != (self.tool is not None):
+            raise ValueError("contact.obstacle = 'tool' and the table contact.tool go together")
+        if self.current_configuration and self.obstacle in ("cylinder", "heightmap"):
+            raise ValueError(f"contact.friction, contact.tool and contact.path work with obstacle = plane, ball or tool, "
+                             f"not {self.obstacle!r}")
+        return self
+
+    @property
+    def current_configuration(self) -> bool:
+        """Friction, a tool or a path: edp/lib/friction.idp (gap and normal in the current configuration)."""
+        return self.friction is not None or self.tool is not None or self.path is not None or self.force is not None
+
+    @property
+    def image_path(self) -> Path:
+        p = Path(self.image or "")
+        return p if p.is_absolute() else ROOT / p
+
+
+def options(block: Contact, scene, files) -> list[str]:
+    """``-contact_*`` options of contact.idp (numbers, ids and the image path only)."""
+    c = list(block.center) + [0.0] * (3 - len(block.center))
+    opts = ["-contact_label", str(LABELS[block.boundary]), "-contact_axis", str(AXES[block.normal[1]]),
+            "-contact_dir", "1" if block.normal[0] == "+" else "-1",
+            "-contact_obstacle", str(OBSTACLES[block.obstacle]),
+            "-contact_cx", repr(c[0]), "-contact_cy", repr(c[1]), "-contact_cz", repr(c[2]),
+            "-contact_R", repr(block.radius), "-contact_cyl_axis", str(AXES[block.cylinder_axis]),
+            "-contact_disp", repr(block.displacement), "-contact_amp", repr(block.height),
+            "-contact_lx", repr(block.size[0]), "-contact_ly", repr(block.size[1]), "-contact_c", repr(block.c),
+            "-contact_ref", str(REFERENCES.get(block.reference, 0))]
+    if block.obstacle == "heightmap":
+        opts += ["-contact_image", str(block.image_path)]
+    if block.current_configuration:
+        opts += friction_options(block, files)
+    return opts
+
+
+def friction_options(block: Contact, files) -> list[str]:
+    """The ``-fric_*``/``-tool_*`` options of friction.idp and tool.idp (its macro WITHFRICTION comes from
+    wendel.loop.launch.macros); the path and polygon tables are written into the run's tables folder (numbers only)."""
+    f = block.friction or Friction(law="none")
+    opts = ["-fric_law", str(FRICTION_LAWS[f.law]), "-fric_mu", repr(f.mu),
+            "-fric_tau", repr(f.tau_max or 0.0), "-fric_c", repr(f.c), "-fric_heat_fraction", repr(f.heat_fraction)]
+    if block.force is not None:
+        opts += ["-tool_force", repr(block.force), "-tool_force_tol", repr(block.force_tol)]
+    if files is None:
+        return opts
+    files.tables.mkdir(parents=True, exist_ok=True)
+    if block.path is not None:
+        rows = block.path.rows()
+        p = files.tables / "tool_path.txt"
+        p.write_text(f"{len(rows)}\n" + "".join(" ".join(repr(float(v)) for v in r) + "\n" for r in rows))
+        opts += ["-tool_path", str(p)]
+    if block.tool is not None:
+        v = block.tool.vertices
+        radii = block.tool.radii or [0.0] * len(v)
+        p = files.tables / "tool_polygon.txt"
+        p.write_text(f"{len(v)}\n" + "".join(f"{float(x)!r} {float(y)!r} {float(r)!r}\n" for (x, y), r in zip(v, radii)))
+        opts += ["-tool_polygon", str(p)]
+    return opts
+
+
+def _check(block: Contact, scene) -> None:
+    """Scene-level rules of friction.idp: a non-symmetric Newton matrix (no CG)."""
+    if block.current_configuration and scene.numerics.solver == "cg":
+        raise ValueError("contact.friction/tool/path/force give a non-symmetric Newton matrix: "
+                         "numerics.solver must be 'direct' or 'ffddm', not 'cg'")
+
+
+register(Block(name="contact", model=Contact, options=options, check=_check, macro="WITHCONTACT",
+               fields=("contact_pressure", "contact_active", "contact_gap", "friction_traction", "friction_slip",
+                       "friction_state")))
+
+
+MEMBRANE_SHAPES = {"staircase": 1, "radial": 2}
+MembraneShapeName = choice(MEMBRANE_SHAPES, "membrane obstacle")
+"""Membrane obstacle name -> ``-obst_id`` of obstacle.edp."""
+
+
+class MembraneObstacle(BaseModel):
+    """The membrane obstacle problem -Laplace(u) = f, u >= g, by PDAS (edp/obstacle.edp)."""
+
+    model_config = ConfigDict(extra="forbid", validate_assignment=True)
+
+    shape: MembraneShapeName = Field("staircase", description="obstacle and data: staircase (step-41, u = 0 on the boundary), "
+                       "radial (g = sqrt(1 - r^2), exact solution as boundary data and reference)")
+    f: Optional[float] = Field(None, description="load density [1/m]; default -10 (staircase), 0 (radial)")
+    c: float = Field(100.0, gt=0, description="active-set constant [1/m^2]; the solution does not depend on it")
+
+
+
+def _membrane_entry(scene, dimension: int) -> str:
+    if dimension != 2:
+        raise ValueError("problem 'membrane-obstacle' is 2D")
+    return "obstacle.edp"
+
+
+def _membrane_options(scene, files, dimension: int) -> list[str]:
+    o = scene.obstacle or MembraneObstacle()
+    opts = ["-obst_id", str(MEMBRANE_SHAPES[o.shape]), "-obst_c", repr(o.c)]
+    if o.f is not None:
+        opts += ["-obst_f", repr(o.f)]
+    return opts
+
+
+register(Block(name="obstacle", model=MembraneObstacle, options=lambda *_: [], fields=("u", "lambda", "active", "gap"),
+               mechanics=False))
+register_problem(Problem(name="membrane-obstacle", entry=_membrane_entry, options=_membrane_options,
+                         tables=("obstacle",)))
+
+
+def bench_obstacle(quick: bool, workdir) -> list[dict]:
+    """step-41 at 3 mesh sizes: active-set iterations, DoFs, wall time (register as ``wendel bench obstacle``)."""
+    from ...loop import run
+    from .. import load
+
+    scene = ROOT / "workflows" / "obstacle.toml"
+    h0 = load(scene).geometry.h
+    rows = []
+    for n in ((16, 32, 64) if quick else (32, 64, 128)):
+        out = workdir / f"n{n}"
+        shutil.rmtree(out, ignore_errors=True)
+        root = run(scene, out=out, scale=2.0 / n / h0, png=False, progress=lambda *_: None)
+        s = json.loads((root / "summary.json").read_text())
+        last = s["last_increment"]
+        rows.append({"cells_per_side": n, "dofs": s["dofs"], "active_set_iterations": last["active_set_iterations"],
+                     "step41_iterations": 18 if n == 128 else None, "active_nodes": last["active_nodes"],
+                     "wall_time": s["wall_time"], "solve_time": last["time_solve"]})
+    return rows
