@@ -151,9 +151,9 @@ def test_hertz_at_a_prescribed_force_in_one_run(tmp_path):
 
 
 def test_scratch_large_sliding_of_a_rounded_wedge(tmp_path):
-    # The wedge (edge radius 0.5 m) pressed 10 mm, then dragged 0.4 m, eight contact widths: the contact
-    # follows the tool (gap and normal recomputed in the current configuration every Newton iteration)
-    # and every active node slides at lambda_t = -mu lambda_n.
+    # The wedge (edge radius 0.5 m) pressed 10 mm into an elastic-plastic block, then dragged 0.4 m, eight
+    # contact widths: the contact follows the tool (gap and normal recomputed in the current configuration
+    # every Newton iteration), every active node slides at lambda_t = -mu lambda_n, the groove yields.
     root = run(WORKFLOWS / "scratch.toml", smoke=True, out=tmp_path / "scr", png=False, progress=lambda *_: None)
     recs = records(root)
     assert [r["load_factor"] for r in recs] == pytest.approx([0.25 * k for k in range(1, 9)])
@@ -164,6 +164,7 @@ def test_scratch_large_sliding_of_a_rounded_wedge(tmp_path):
         assert r["friction_stick_nodes"] == 0
         assert abs(r["friction_force"]) == pytest.approx(0.2 * r["normal_force"], rel=1e-8)
     assert recs[-1]["tool_x"] == pytest.approx(0.4)
+    assert recs[-1]["plastic_points"] > 50
     from wendel.results import vtu as output
 
     pts = output.read_vertices(root / "fem" / "vertices.txt")
