@@ -84,6 +84,30 @@ def test_sliding_block_tresca_slides_at_the_bound(tmp_path):
     assert all(r[k] < 1e-8 for r in recs for k in KKT)
 
 
+def test_sliding_block_3d_slides_along_the_drag(tmp_path):
+    # 3D: the cube pressed on a plane, then dragged along (4, 3) / 5: every node ends up sliding with
+    # |lambda_t| = mu lambda_n (node fields, 1e-8), the total friction force turns to the drag direction and its
+    # ratio to the normal force tends to mu as the slip directions align (the 3D slip direction is solved by
+    # the semismooth Newton step of Hueber-Stadler-Wohlmuth, not frozen).
+    from wendel.results import vtu as output
+
+    root = run(WORKFLOWS / "sliding-block-3d.toml", smoke=True, out=tmp_path / "s3", png=False, progress=lambda *_: None)
+    recs = records(root)
+    assert len(recs) == 11 and recs[1]["friction_stick_nodes"] > 0 and recs[-1]["friction_stick_nodes"] == 0
+    for r in recs:
+        assert all(r[k] < 1e-8 for k in KKT), {k: r[k] for k in KKT}
+        assert r["newton_iterations"] <= 10
+    last = recs[-1]
+    assert last["friction_ratio"] == pytest.approx(0.3, rel=1e-6)
+    assert last["contact_force_x"] / last["contact_force_y"] == pytest.approx(4 / 3, rel=1e-3)
+    d = root / "fem" / "inc-0011"
+    p = output.read_array(d / "contact_pressure.node.txt")
+    t = output.read_array(d / "friction_traction.node.txt")
+    active = output.read_array(d / "contact_active.node.txt") > 0.5
+    assert active.sum() == last["contact_active_nodes"] > 10
+    assert np.abs(t[active] - 0.3 * p[active]).max() <= 1e-8 * p[active].max()
+
+
 def test_one_and_two_ranks_agree(tmp_path):
     # Every rank holds the whole frictional system (its sets are the same on every rank); ffddm's GMRES
     # solves the non-symmetric Newton matrix on 2 ranks.

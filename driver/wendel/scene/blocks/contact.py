@@ -11,8 +11,8 @@ through a registry of names to the integer ids of ``-contact_obstacle``:
 >>> options(Contact(boundary="top", normal="+z", displacement=-1e-3), None, None)[:6]
 ['-contact_label', '4', '-contact_axis', '2', '-contact_dir', '1']
 
-Friction, a tool of any shape, a tool path or force control switch to edp/lib/friction.idp (current
-configuration, 2D) through the extra macro ``-DWITHFRICTION=1`` (wendel.loop.launch.macros):
+Friction, a tool of any shape (2D polygon), a tool path or force control switch to edp/lib/friction.idp
+(current configuration, 2D and 3D) through the extra macro ``-DWITHFRICTION=1`` (wendel.loop.launch.macros):
 
 >>> c = Contact(boundary="bottom", normal="-y", friction={"law": "coulomb", "mu": 0.3})
 >>> c.current_configuration, options(c, None, None)[-10:-6]
@@ -55,8 +55,8 @@ ROOT = Path(__file__).resolve().parents[4]
 
 
 class Friction(BaseModel):
-    """Friction between the body and the tool (edp/lib/friction.idp): Coulomb (optionally capped in shear)
-    or Tresca, with stick, slip and inactive sets in the same semismooth Newton as the normal contact."""
+    """Friction between the body and the tool (edp/lib/friction.idp, 2D and 3D): Coulomb (optionally capped
+    in shear) or Tresca, with stick, slip and inactive sets in the same semismooth Newton as the normal contact."""
 
     model_config = ConfigDict(extra="forbid", validate_assignment=True)
 
@@ -106,24 +106,25 @@ class ToolPath(BaseModel):
     load_factors: list[float] = Field(..., min_length=1, description="load factors of the path points, increasing [1]")
     x: Optional[list[float]] = Field(None, description="translation along x at those load factors [m]; default 0")
     y: Optional[list[float]] = Field(None, description="translation along y at those load factors [m]; default 0")
-    angle: Optional[list[float]] = Field(None, description="rotation about contact.center, counter-clockwise [deg]; default 0")
+    z: Optional[list[float]] = Field(None, description="translation along z at those load factors (3D) [m]; default 0")
+    angle: Optional[list[float]] = Field(None, description="rotation about contact.center, counter-clockwise (2D) [deg]; default 0")
 
     @model_validator(mode="after")
     def _lengths(self):
         n = len(self.load_factors)
         if any(b <= a for a, b in zip(self.load_factors, self.load_factors[1:])):
             raise ValueError("contact.path.load_factors must increase")
-        for key in ("x", "y", "angle"):
+        for key in ("x", "y", "z", "angle"):
             val = getattr(self, key)
             if val is not None and len(val) != n:
                 raise ValueError(f"contact.path.{key} needs {n} values (one per load factor)")
         return self
 
-    def rows(self) -> list[tuple[float, float, float, float]]:
-        """(load factor, x, y, angle in rad) per path point."""
+    def rows(self) -> list[tuple[float, float, float, float, float]]:
+        """(load factor, x, y, z, angle in rad) per path point."""
         n = len(self.load_factors)
-        x, y, a = (self.x or [0.0] * n), (self.y or [0.0] * n), (self.angle or [0.0] * n)
-        return [(lf, xi, yi, math.radians(ai)) for lf, xi, yi, ai in zip(self.load_factors, x, y, a)]
+        x, y, z, a = (self.x or [0.0] * n), (self.y or [0.0] * n), (self.z or [0.0] * n), (self.angle or [0.0] * n)
+        return [(lf, xi, yi, zi, math.radians(ai)) for lf, xi, yi, zi, ai in zip(self.load_factors, x, y, z, a)]
 
 
 class Contact(BaseModel):
@@ -143,11 +144,11 @@ class Contact(BaseModel):
     size: list[float] = Field([1.0, 1.0], description="heightmap: footprint along the two tangential axes [m]")
     c: float = Field(0.0, ge=0, description="active-set constant [Pa/m]; 0 = E / h_min (the solution does not depend on it)")
     reference: Optional[ContactReferenceName] = Field(None, description=f"reference solution: {', '.join(REFERENCES)} (contact size and peak pressure)")
-    friction: Optional[Friction] = Field(None, description="friction law (2D; absent: frictionless)")
+    friction: Optional[Friction] = Field(None, description="friction law (absent: frictionless)")
     tool: Optional[Tool] = Field(None, description="obstacle = 'tool': the polygon with rounded corners (2D)")
-    path: Optional[ToolPath] = Field(None, description="the obstacle's motion along the load factor (2D)")
+    path: Optional[ToolPath] = Field(None, description="the obstacle's motion along the load factor (3D: translation only)")
     force: Optional[float] = Field(None, gt=0, description="force control: the pressing force along the normal axis at load "
-                                   "factor 1 [N/m in 2D]; the tool's position along that axis is solved for (displacement = first guess) (2D)")
+                                   "factor 1 [N; N/m in 2D]; the tool's position along that axis is solved for (displacement = first guess)")
     force_tol: float = Field(1e-9, gt=0, lt=1e-2, description="force control: relative tolerance on the force [1]")
 
 
