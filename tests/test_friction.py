@@ -108,6 +108,22 @@ def test_sliding_block_3d_slides_along_the_drag(tmp_path):
     assert np.abs(t[active] - 0.3 * p[active]).max() <= 1e-8 * p[active].max()
 
 
+def test_force_control_in_3d_presses_and_drags_at_the_target_force(tmp_path):
+    # The 3D block pressed by the plane with lf x 2e5 N (its height solved for), dragged from load factor 1 on:
+    # the pressing force meets the target in every increment and the drag slides at about mu times it (the
+    # slip directions of the nodes are not yet aligned: the vector sum is 0.1% below mu N here).
+    scene = variant(tmp_path, "sliding-block-3d", {
+        "z = [0.0, 0.01, 0.01] }": "z = [0.0, 0.0, 0.0] }",
+        'center = [0.0, 0.0, 0.0] # m': 'force = 2.0e5\ndisplacement = 0.005\ncenter = [0.0, 0.0, 0.0] # m'})
+    root = run(scene, smoke=True, out=tmp_path / "f3", png=False, progress=lambda *_: None)
+    recs = records(root)
+    for r in recs:
+        assert r["pressing_force"] == pytest.approx(2.0e5 * r["load_factor"], rel=1e-8) and r["error_force"] < 1e-8
+        assert all(r[k] < 1e-8 for k in KKT)
+    assert recs[-1]["friction_stick_nodes"] == 0 and recs[-1]["friction_ratio"] == pytest.approx(0.3, rel=2e-3)
+    assert recs[-1]["tool_z"] > 0.005                             # m: the plane rose to carry the load
+
+
 def test_one_and_two_ranks_agree(tmp_path):
     # Every rank holds the whole frictional system (its sets are the same on every rank); ffddm's GMRES
     # solves the non-symmetric Newton matrix on 2 ranks.
