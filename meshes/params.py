@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import inspect
 import math
+import typing
 from typing import Annotated, Any, Optional
 
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, ValidationError, create_model, model_validator
@@ -77,6 +78,38 @@ KNOWN: dict[str, Any] = {
     "center": Point,
     "refine": Optional[Refine],
 }
+
+
+# What a builder keyword means, for `wendel keys` and the README (others: "a keyword of the builder").
+HELP = {
+    "x": "interval [x0, x1] of the domain along x [m]", "y": "interval [y0, y1] along y [m]",
+    "z": "interval [z0, z1] along z [m]", "r": "interval [r0, r1] of the radius [m]",
+    "radius": "radius of the body [m]", "r_inner": "inner radius, below r_outer [m]",
+    "r_outer": "outer radius [m]", "length": "length of the body [m]", "height": "height of the body [m]",
+    "center": "centre of the body [m]", "structured": "transfinite (structured) mesh, for convergence studies",
+    "quarter": "model a quarter with symmetry planes", "refine": "a zone of finer elements (table below)",
+}
+
+
+def keyword_rows() -> list[tuple[str, str, str, str]]:
+    """(key, type, defaults, meaning) of every builder keyword, one row per name, for the key table."""
+    by_name: dict[str, list[tuple[str, Any]]] = {}
+    for builder in sorted(BUILDERS):
+        for name, f in model(builder).model_fields.items():
+            if name != "h":
+                by_name.setdefault(name, []).append((builder, f))
+    rows = []
+    for name, items in sorted(by_name.items()):
+        f = items[0][1]
+        ann = typing.get_args(f.annotation)[0] if typing.get_origin(f.annotation) is Annotated else f.annotation
+        typ = "table, optional" if name == "refine" else str(ann) if "[" in str(ann) else ann.__name__
+        defaults = "; ".join(f"{b}: {'required' if g.is_required() else repr(g.default)}" for b, g in items)
+        rows.append((f"geometry.{name}", typ, defaults,
+                     f"{HELP.get(name, 'a keyword of the builder')} (builders: {', '.join(b for b, _ in items)})"))
+    kinds = {"center": "list[float]", "box": "list[list[float]]"}
+    for name, f in Refine.model_fields.items():
+        rows.append((f"geometry.refine.{name}", f"{kinds.get(name, 'float')}, optional", "None", f.description or ""))
+    return rows
 
 
 def _type_of(name: str, default: Any):

@@ -7,16 +7,21 @@ the progress lines in :mod:`.progress`, the remesh step in :mod:`wendel.remesh.s
 
 from __future__ import annotations
 
+import contextlib
+import errno
 import json
 import shutil
+import tempfile
 import time
 from pathlib import Path
 
 from .. import freefem
+from ..errors import DiskFull, Interrupted, RunFolderError
 from ..meshes import build as build_mesh
 from ..remesh.step import finish_report, judge, maybe_remesh
 from ..results import pictures, summary, vtu
 from ..scene import load
+from ..scene.reading import check_size
 from ..scene.schema import Scene
 from .checkpoint import RunFiles, State, load_state, save as _save_checkpoint
 from .launch import entry_script, macros, options, write_tables
@@ -35,9 +40,13 @@ def run(scene_path: str | Path, smoke: bool = False, ranks: int | None = None, o
     given from its last checkpoint.
     """
     if resume is not None:
-        files, scene, state = _resume(Path(resume).resolve())
-        progress(f"resuming {files.root} after increment {state.last[0]} (load factor {state.last[1]:g})")
-        return _execute(scene, files, state, progress)
+        root = Path(resume).resolve()
+        if not (root / "checkpoint.json").is_file() and (root / "scene.resolved.json").is_file():
+            return _restart(root, progress)
+        with guarded(root):
+            files, scene, state = _resume(root, progress)
+            progress(f"resuming {files.root} after increment {state.last[0]} (load factor {state.last[1]:g})")
+            return _execute(scene, files, state, progress)
     scene_path = Path(scene_path)
     scene = load(scene_path, smoke=smoke)
     if scale is not None:
@@ -61,12 +70,49 @@ def run_scene(scene: Scene, scene_path: Path, out: Path, smoke: bool = False, pr
         # never mix a new run with the files of another (nor delete them): a new folder, or --resume
         raise ValueError(f"run folder {files.root} exists and is not empty: choose another --out, or continue "
                          f"the run in it with `wendel run --resume {files.root}`")
-    files.root.mkdir(parents=True, exist_ok=True)
-    summary.write_provenance(files.root, Path(scene_path), scene, smoke)
-    state = State(pending=scene.loading.load_factors())
-    state.mesh_seconds, dimension = build(scene, files)
-    _save_checkpoint(files, scene, state, dimension)
-    return _execute(scene, files, state, progress)
+    if files.root.exists() and not files.root.is_dir():
+        raise RunFolderError(f"run folder (--out) {out}: is a file, not a folder")
+    try:
+        files.root.mkdir(parents=True, exist_ok=True)
+        (files.root / ".write-test").touch()
+        (files.root / ".write-test").unlink()
+    except OSError as exc:
+        raise RunFolderError(f"run folder (--out) {out}: cannot be created or written: {exc.strerror}") from None
+    check_size(scene, str(scene_path))       # h may have been scaled since the scene was read (studies)
+    with guarded(files.root):
+        summary.write_provenance(files.root, Path(scene_path), scene, smoke)
+        state = State(pending=scene.loading.load_factors())
+        state.mesh_seconds, dimension = build(scene, files)
+        _save_checkpoint(files, scene, state, dimension)
+        return _execute(scene, files, state, progress)
+
+
+@contextlib.contextmanager
+def guarded(root: Path):
+    """Name the run folder when a run stops short: Ctrl-C or SIGTERM (FreeFEM is stopped with the driver)
+    becomes :class:`Interrupted`, a full disk (of the driver's files or FreeFEM's) :class:`DiskFull`."""
+    try:
+        yield
+    except Interrupted:
+        raise
+    except KeyboardInterrupt:
+        raise Interrupted(root) from None
+    except OSError as exc:
+        if exc.errno == errno.ENOSPC:
+            raise DiskFull(root) from None
+        raise
+    except (freefem.FreeFemError, ValueError):
+        if _disk_full(root):
+            raise DiskFull(root) from None
+        raise
+
+
+def _disk_full(root: Path) -> bool:
+    """Whether the file system of ``root`` has (almost) no room left for another increment."""
+    try:
+        return shutil.disk_usage(root).free < 64 * 1024
+    except OSError:
+        return False
 
 
 def _execute(scene: Scene, files: RunFiles, state: State, progress) -> Path:
@@ -75,18 +121,36 @@ def _execute(scene: Scene, files: RunFiles, state: State, progress) -> Path:
     progress(f"wendel: {scene.description}")
     progress(f"  run folder {files.root}")
     try:
-        if scene.remesh and state.accepted and state.pending and not state.reequilibrate:
+        segment = state.segments[-1]
+        after_reequilibration = len(state.segments) > 1 and state.last[0] == segment["first"]
+        if scene.remesh and state.accepted and state.pending and not state.reequilibrate \
+                and not after_reequilibration:
             maybe_remesh(scene, files, state, dimension, progress)    # a run resumed before the decision
         solve(scene, files, state, dimension, progress)
     finally:
-        summary.write_summary(files.root, scene, state, dimension)
+        with contextlib.suppress(OSError):       # a full disk must not hide why the run stopped
+            summary.write_summary(files.root, scene, state, dimension)
     if scene.output.png and state.accepted:
         t0 = time.perf_counter()
-        last = files.vtu / f"inc-{state.last[0]:04d}.vtu"
-        pictures.picture(last, files.root / "deformed.png", f"load factor {state.last[1]:g}", scene.output.warp)
+        inc, lf = state.last
+        if scene.output.vtu:
+            pictures.picture(files.vtu / f"inc-{inc:04d}.vtu", files.root / "deformed.png", f"load factor {lf:g}",
+                             scene.output.warp)
+        else:            # no VTU series: the picture is made from a VTU of the last increment that is not kept
+            with tempfile.TemporaryDirectory() as tmp:
+                _write_increment_vtu(files, state, dimension, inc, Path(tmp) / "last.vtu")
+                pictures.picture(Path(tmp) / "last.vtu", files.root / "deformed.png", f"load factor {lf:g}",
+                                 scene.output.warp)
         state.post_seconds += time.perf_counter() - t0
         summary.write_summary(files.root, scene, state, dimension)
     return files.root
+
+
+def _write_increment_vtu(files: RunFiles, state: State, dimension: int, inc: int, path: Path) -> None:
+    """The VTU of accepted increment ``inc`` at ``path``."""
+    points, cells = vtu.read_mesh(files.root / state.segment(inc)["mesh"], dimension)
+    pdata, cdata = vtu.increment_fields(files.fem / f"inc-{inc:04d}", len(points), len(cells), dimension)
+    vtu.write_vtu(path, points, cells, dimension, pdata, cdata)
 
 
 def build(scene: Scene, files: RunFiles) -> tuple[float, int]:
@@ -137,6 +201,11 @@ def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress)
             accept(scene, files, state, dimension)
             state.launches.append({"wall": time.perf_counter() - t0, "increments": len(state.accepted) - before,
                                    "complete": failure is None})
+        if failure is None and len(state.accepted) - before < len(batch):
+            if _disk_full(files.root):
+                raise DiskFull(files.root)
+            raise freefem.FreeFemError(f"FreeFEM ended without committing increment {state.last[0] + 1} whole "
+                                       f"(see {files.fem / f'inc-{state.last[0] + 1:04d}'})")
         if failure is not None:
             cut_step(scene, files, state, failure, progress)
             _save_checkpoint(files, scene, state, dimension)
@@ -144,15 +213,33 @@ def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress)
         if scene.loading.adaptive and not state.reequilibrate:
             grow_step(scene, state, files)
         if state.reequilibrate:
-            state.reequilibrate = False
-            rep = state.remeshes[-1]
-            finish_report(rep, files.fem / f"inc-{state.last[0]:04d}",
-                                    files.root / "remesh" / f"remesh-{len(state.remeshes)}.json")
-            progress(f"  re-equilibrated on the new mesh: relative residual {rep['residual_after_transfer']:.2e}"
-                     f" -> {rep['residual_after_reequilibration']:.2e}")
+            _reequilibrated(files, state, progress)
         elif scene.remesh and state.pending:
             maybe_remesh(scene, files, state, dimension, progress)
         _save_checkpoint(files, scene, state, dimension)
+
+
+def _reequilibrated(files: RunFiles, state: State, progress) -> None:
+    """The increment on a new mesh is accepted: the remesh is complete (its report gets the residuals)."""
+    state.reequilibrate = False
+    rep = state.remeshes[-1]
+    finish_report(rep, files.fem / f"inc-{state.last[0]:04d}",
+                  files.root / "remesh" / f"remesh-{len(state.remeshes)}.json")
+    progress(f"  re-equilibrated on the new mesh: relative residual {rep['residual_after_transfer']:.2e}"
+             f" -> {rep['residual_after_reequilibration']:.2e}")
+
+
+def committed(inc_dir: Path) -> dict | None:
+    """The record of increment folder ``inc_dir`` if FreeFEM committed it whole (its `done` marker, a
+    readable record.json and every array file complete), else None."""
+    if not (inc_dir / "done").is_file():
+        return None
+    try:
+        record = json.loads((inc_dir / "record.json").read_text())
+    except (OSError, ValueError):
+        return None
+    arrays = [p for p in inc_dir.glob("*.txt")]
+    return record if all(vtu.complete_array(p) for p in arrays) else None
 
 
 def accept(scene: Scene, files: RunFiles, state: State, dimension: int) -> None:
@@ -162,9 +249,9 @@ def accept(scene: Scene, files: RunFiles, state: State, dimension: int) -> None:
     while state.pending:
         inc = state.last[0] + 1
         d = files.fem / f"inc-{inc:04d}"
-        if not (d / "done").is_file():
+        record = committed(d)
+        if record is None:
             break
-        record = json.loads((d / "record.json").read_text())
         seg = state.segment(inc)
         if seg["mesh"] not in meshes:
             points, cells = vtu.read_mesh(files.root / seg["mesh"], dimension)
@@ -176,6 +263,9 @@ def accept(scene: Scene, files: RunFiles, state: State, dimension: int) -> None:
         if scene.problem == "mechanics":
             extra.update(judge(points, cells, vtu.read_array(d / "u.node.txt"), dimension))
             state.quality[inc] = extra
+            if extra.get("inverted", 0) > 0 and scene.remesh is None:
+                print(f"  warning: increment {inc}: {extra['inverted']} inverted elements in the deformed mesh "
+                      f"(no [remesh] table); see summary.json warnings")
         if scene.output.vtu:
             pdata, cdata = vtu.increment_fields(d, len(points), len(cells), dimension)
             files.vtu.mkdir(exist_ok=True)
@@ -203,11 +293,33 @@ def _new_run_dir(scene_path: Path, smoke: bool) -> Path:
             d = base.with_name(f"{base.name}-{k}")
 
 
-def _resume(root: Path) -> tuple[RunFiles, Scene, State]:
+def _restart(root: Path, progress) -> Path:
+    """A run stopped before its first checkpoint (while meshing): nothing was computed, so it starts again
+    in its own folder from the scene it saved there."""
+    scene = Scene.model_validate(json.loads((root / "scene.resolved.json").read_text()))
+    smoke = False
+    with contextlib.suppress(OSError, ValueError, KeyError):
+        smoke = bool(json.loads((root / "provenance.json").read_text())["smoke"])
+    progress(f"resuming {root}: it stopped before its first increment; starting it again")
+    with tempfile.TemporaryDirectory() as tmp:
+        source = Path(tmp) / "scene.toml"
+        if (root / "scene.toml").is_file():
+            shutil.copyfile(root / "scene.toml", source)
+        else:
+            source.write_text("# the scene file was not saved before the run stopped; see scene.resolved.json\n")
+        for p in root.iterdir():
+            shutil.rmtree(p) if p.is_dir() else p.unlink()
+        return run_scene(scene, source, root, smoke, progress)
+
+
+def _resume(root: Path, progress=print) -> tuple[RunFiles, Scene, State]:
     files, scene, state, dimension = load_state(root)
     # An increment committed after the last checkpoint is taken as it is; a partial one is dropped.
     summary.truncate_history(files.root, state.last[0])
     accept(scene, files, state, dimension)
+    if state.reequilibrate and state.accepted and state.last[0] >= state.segments[-1]["first"]:
+        _reequilibrated(files, state, progress)      # stopped after the re-equilibration was committed
+        _save_checkpoint(files, scene, state, dimension)
     nxt = files.fem / f"inc-{state.last[0] + 1:04d}"
     if nxt.is_dir():
         shutil.rmtree(nxt)

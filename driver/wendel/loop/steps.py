@@ -6,12 +6,9 @@ import json
 import shutil
 
 from .. import freefem
+from ..errors import StepCutError
 from ..scene.schema import Scene
 from .checkpoint import RunFiles, State
-
-
-class StepCutError(RuntimeError):
-    """An increment failed after every allowed step cut; accepted increments are on disk."""
 
 
 def plan_step(scene: Scene, state: State) -> None:
@@ -53,8 +50,13 @@ def cut_step(scene: Scene, files: RunFiles, state: State, failure: freefem.Newto
     if reason == "limit load reached" or abs(mid - lf_prev) < smallest * (1 - 1e-9):
         what = "limit load reached" if reason == "limit load reached" else \
             f"{reason}, even after {scene.loading.max_cuts} step halvings (loading.max_cuts)"
+        # the bracket of the limit (or of the failure): summary.json reports it
+        (files.root / "stopped.json").write_text(json.dumps(
+            {"increment": inc, "reason": what, "last_converged_load_factor": lf_prev,
+             "first_failed_load_factor": lf_fail}, indent=1))
         raise StepCutError(
-            f"increment {inc} (load factor {lf_prev:g} -> {lf_fail:g}): {what}; "
+            f"increment {inc} (load factor {lf_prev:g} -> {lf_fail:g}): {what} between load factor {lf_prev:g} "
+            f"(last converged) and {lf_fail:g} (first failed); "
             f"{len(state.accepted)} accepted increments are kept in {files.root}")
     if scene.loading.adaptive:
         state.step = abs(mid - lf_prev)

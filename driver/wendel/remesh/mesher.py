@@ -30,6 +30,7 @@ from pathlib import Path
 import meshio
 import numpy as np
 
+from ..meshes.builders import start_gmsh
 from . import quality
 
 __all__ = ["remesh", "read_mesh", "boundary_facets"]
@@ -253,11 +254,8 @@ def remesh(points_deformed, mesh_in_path, out_path, h, size_indicator=None, h_mi
     labels = _label_facets(bf, facets, facet_tags)
     h_min = h / 4 if h_min is None else h_min
 
-    gmsh.initialize(["-noenv"], readConfigFiles=False)
+    start_gmsh()          # keeps the driver's Ctrl-C and SIGTERM handlers
     try:
-        gmsh.option.setNumber("General.Terminal", 0)
-        gmsh.option.setNumber("General.NumThreads", 1)
-        gmsh.option.setNumber("Mesh.RandomSeed", 1)
         gmsh.model.add("remesh")
         groups = defaultdict(list)
         if dim == 2:

@@ -46,7 +46,9 @@ def _freefem_version() -> str:
 def write_provenance(root: Path, scene_path: Path, scene, smoke: bool) -> None:
     """The scene as run and where it ran: commit, versions, command line, host, start time."""
     shutil.copyfile(scene_path, root / "scene.toml")
-    (root / "scene.resolved.json").write_text(json.dumps(scene.model_dump(mode="json"), indent=1))
+    tmp = root / "scene.resolved.json.tmp"      # atomic: a run stopped before its checkpoint restarts from it
+    tmp.write_text(json.dumps(scene.model_dump(mode="json"), indent=1))
+    os.replace(tmp, root / "scene.resolved.json")
     versions = {"wendel": __version__, "python": sys.version.split()[0], "freefem++": _freefem_version()}
     for pkg in ("gmsh", "meshio", "numpy", "scipy", "pydantic", "pyvista", "matplotlib"):
         try:
@@ -84,7 +86,10 @@ def truncate_history(root: Path, last_increment: int) -> None:
         if not path.is_file():
             continue
         lines = path.read_text().splitlines()
-        keep = lines[:1] + [l for l in lines[1:] if int(float(l.split(",", 1)[0])) <= last_increment]
+        width = len(lines[0].split(",")) if lines else 0
+        # a row cut short by a crash or a full disk has fewer fields than the header: dropped
+        keep = lines[:1] + [l for l in lines[1:] if len(l.split(",")) == width
+                            and int(float(l.split(",", 1)[0])) <= last_increment]
         tmp = path.with_suffix(".tmp")
         tmp.write_text("\n".join(keep) + "\n")
         os.replace(tmp, path)
@@ -143,8 +148,11 @@ def write_summary(root: Path, scene, state, dimension: int) -> dict:
         if total else None,
         "remeshes": state.remeshes,
         "errors": _errors(last),
+        "warnings": warnings(state, scene),
         "last_increment": last,
     }
+    if (root / "stopped.json").is_file():
+        summary["stopped"] = json.loads((root / "stopped.json").read_text())
     prov_path = root / "provenance.json"
     if prov_path.is_file():
         prov = json.loads(prov_path.read_text())
@@ -154,6 +162,16 @@ def write_summary(root: Path, scene, state, dimension: int) -> dict:
     tmp.write_text(json.dumps(summary, indent=1))
     os.replace(tmp, root / "summary.json")
     return summary
+
+
+def warnings(state, scene) -> list[str]:
+    """Silent trouble of accepted increments: inverted elements in a deformed mesh that was not remeshed."""
+    inverted = sorted(inc for inc, q in state.quality.items() if q.get("inverted", 0) > 0)
+    if not inverted:
+        return []
+    what = "no [remesh] table" if scene.remesh is None else "remeshing did not remove them"
+    return [f"increments {', '.join(map(str, inverted))}: the deformed mesh has inverted elements ({what}); "
+            f"results there are not trustworthy"]
 
 
 def _errors(last: dict) -> dict:

@@ -29,6 +29,33 @@ def read_array(path: Path) -> np.ndarray:
     return data[1:]
 
 
+def complete_array(path: Path) -> bool:
+    r"""Whether the array file ``path`` holds all the values its count announces, i.e. it was not cut short
+    by a crash or a full disk.
+
+    FreeFEM writes ``n``, then rows of 5 values, the last one ending with a tab: checked by counting rows
+    and the last row's values (no parsing of the rest); another layout is parsed whole.
+
+    >>> import tempfile; p = Path(tempfile.mkdtemp()) / "a.txt"
+    >>> _ = p.write_text("7\t\n\t1\t2\t3\t4\t5\n\t6\t7\t")
+    >>> complete_array(p), (p.write_text("7\t\n\t1\t2\t3\t4\t5\n\t6\t7") and complete_array(p))
+    (True, False)
+    """
+    try:
+        data = path.read_bytes()
+        head, _, body = data.partition(b"\n")
+        n = int(head)
+        rows = -(-n // 5)
+        last = body[body.rfind(b"\n") + 1:]
+        if data.endswith(b"\t") and body.count(b"\n") == rows - 1 and len(last.split()) == n - 5 * (rows - 1):
+            return True
+        if data.endswith(b"\t") or b"\t" not in body:
+            return read_array(path).size == n         # another layout (one value per line): parse it
+        return False
+    except (OSError, ValueError):
+        return False
+
+
 def write_array(path: Path, values) -> None:
     """Write edp's plain array format (count, then one value per line, full precision)."""
     v = np.asarray(values, dtype=float).ravel()

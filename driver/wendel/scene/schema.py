@@ -144,6 +144,9 @@ class Numerics(Strict):
     newton_tol: float = Field(1e-9, gt=0, lt=1, description="relative Newton residual [1]")
     newton_maxit: int = Field(25, ge=1, le=500, description="Newton iterations per increment")
     timeout: float = Field(3600.0, gt=0, description="wall-time limit of one FreeFEM launch [s]")
+    max_elements: float = Field(3e6, gt=0, description="refuse a mesh estimated above this many elements before "
+                                "meshing (about 1 GB per 300k 3D elements here; raise it on a bigger machine) [1]")
+    max_increments: int = Field(100000, ge=1, description="refuse a load path of more increments than this [1]")
 
 
     @model_validator(mode="after")
@@ -235,7 +238,8 @@ class SceneBase(Strict):
     def _consistency(self):
         if self.problem == "mechanics":
             if self.material is None:
-                raise ValueError("material: Field required")
+                raise ValueError("material: Field required (problem = \"mechanics\", the default, needs it; "
+                                 "a scalar problem is named by `problem`)")
             foreign = [n for n, b in BLOCKS.items() if not b.mechanics and getattr(self, n, None) is not None]
             if foreign:
                 raise ValueError(f"table(s) {', '.join(foreign)} belong to another problem; set `problem`")
@@ -315,7 +319,11 @@ def update_readme(path) -> bool:
 
 def keys_table() -> str:
     """The scene keys as a Markdown table (the README's table is this text; a test keeps them equal)."""
+    from ..meshes.params import keyword_rows
+
     rows = _describe(Scene, "")
+    at = next(i for i, r in enumerate(rows) if r[0].startswith("geometry.")) + 1
+    rows[at:at] = keyword_rows()      # the builders' keywords after geometry.builder
     lines = ["| key | type | default | meaning |", "|---|---|---|---|"]
     lines += [f"| `{k}` | {t} | {d} | {m} |" for k, t, d, m in rows]
     return "\n".join(lines)

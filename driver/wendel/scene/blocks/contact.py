@@ -168,6 +168,7 @@ class Contact(BaseModel):
                 raise ValueError("contact.obstacle = 'heightmap' needs contact.image")
             if not self.image_path.is_file():
                 raise ValueError(f"contact.image: no such file {self.image_path}")
+            image_size(self.image_path)
         if self.cylinder_axis not in AXES or (self.obstacle == "cylinder" and self.cylinder_axis == self.normal[1]):
             raise ValueError("contact.cylinder_axis must be x, y or z and differ from the normal's axis")
         if len(self.center) not in (2, 3) or len(self.size) != 2:
@@ -190,6 +191,35 @@ class Contact(BaseModel):
     def image_path(self) -> Path:
         p = Path(self.image or "")
         return p if p.is_absolute() else ROOT / p
+
+
+MAX_PIXELS = 16_000_000     # a height map larger than 4000 x 4000 is refused (FreeFEM reads it as text)
+
+
+def image_size(path: Path) -> tuple[int, int]:
+    """(width, height) of the PGM/PPM image ``path``; ValueError naming contact.image if it is not one of
+    those formats or its size is absurd.
+
+    >>> image_size(ROOT / "workflows" / "images" / "stamp.pgm")[0] > 1
+    True
+    """
+    head = path.read_bytes()[:4096]
+    if head[:2] not in (b"P2", b"P3", b"P5", b"P6"):
+        raise ValueError(f"contact.image: {path} is not a PGM or PPM image (no P2/P3/P5/P6 header); convert it, "
+                         f"e.g. with `convert IMAGE -compress none OUT.pgm`")
+    words = []
+    for line in head[2:].split(b"\n"):
+        words += line.split(b"#", 1)[0].split()
+        if len(words) >= 2:
+            break
+    try:
+        w, h = int(words[0]), int(words[1])
+    except (IndexError, ValueError):
+        raise ValueError(f"contact.image: {path}: unreadable PGM/PPM header") from None
+    if not (2 <= w <= 8192 and 2 <= h <= 8192 and w * h <= MAX_PIXELS):
+        raise ValueError(f"contact.image: {path} is {w} x {h} pixels; wendel takes 2 to 8192 per side and at "
+                         f"most {MAX_PIXELS:,} pixels")
+    return w, h
 
 
 def options(block: Contact, scene, files) -> list[str]:
