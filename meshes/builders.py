@@ -245,7 +245,7 @@ def disk(path: Path, radius=1.0, center=(0.0, 0.0), h=0.1) -> Built:
         return _write(gmsh, path, 2, ["outer"])
 
 
-@register("parallelogram")
+@register("parallelogram", ["left", "right", "bottom", "top"])
 def parallelogram(path: Path, x=(0.0, 1.0), y=(0.0, 1.0), slope=0.0, h=0.1) -> Built:
     """The rectangle [x0, x1] x [y0, y1] (m) sheared vertically by ``slope`` (1): the point (x, y) moves to
     (x, y + slope (x - x0)); a block resting on an incline of angle atan(slope). Boundaries left and right
