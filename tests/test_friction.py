@@ -247,6 +247,22 @@ def test_capped_coulomb_slides_at_min_of_mu_p_and_the_cap(tmp_path):
     assert (mu * p[active] > tau).sum() >= 3 and (mu * p[active] < tau).sum() >= 3    # both branches present
 
 
+def test_restarts_between_increments_keep_the_friction_state(tmp_path):
+    # loading.adaptive launches FreeFEM once per increment from the last checkpoint (-restart): the sets, the
+    # load factor and tool position of the last increment and the frictional work come back from its folder.
+    factors = "factors = [" + ", ".join(f"{0.1 * k:.1f}" for k in range(1, 21)) + "]"
+    old = "factors = [1.0, 1.1, 1.2, 1.3, 1.4, 1.5, 1.6, 1.7, 1.8, 1.9, 2.0]"
+    runs = {}
+    for name, head in (("one", "[loading]\n"), ("many", "[loading]\nadaptive = true\n")):
+        (tmp_path / name).mkdir()
+        scene = variant(tmp_path / name, "sliding-block", {old: factors, "[loading]\n": head})
+        runs[name] = records(run(scene, smoke=True, out=tmp_path / name / "run", png=False, progress=lambda *_: None))
+    a, b = runs["one"][-1], runs["many"][-1]
+    assert len(runs["many"]) == len(runs["one"]) == 20
+    for key in ("friction_force", "normal_force", "friction_work"):
+        assert b[key] == pytest.approx(a[key], rel=1e-10), key
+
+
 def test_bad_friction_input_is_named(tmp_path):
     from wendel.scene import load
 
