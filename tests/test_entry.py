@@ -23,8 +23,10 @@ from conftest import WORKFLOWS
 
 GUARDS = {"plasticity": "wendelPlasticityIdp", "contact": "wendelContactIdp", "thermal": "wendelThermalIdp",
           "thermal-fields": "wendelThermalFieldsIdp", "elasticity": "wendelElasticityIdp",
-          "friction": "wendelFrictionIdp", "tool": "wendelToolIdp"}
-MODULES = ("plasticity", "contact", "thermal", "thermal-fields", "friction", "tool")
+          "axisymmetric": "wendelAxisymmetricIdp", "axisymmetric-mechanics": "wendelAxisymmetricMechanicsIdp",
+          "remeshstop": "wendelRemeshStopIdp", "friction": "wendelFrictionIdp", "tool": "wendelToolIdp"}
+MODULES = ("plasticity", "contact", "thermal", "thermal-fields", "axisymmetric", "axisymmetric-mechanics", "remeshstop", "friction",
+           "tool")
 
 
 def compiled(tmp_path, scene_name: str) -> tuple[set[str], list[str], dict]:

@@ -11,6 +11,8 @@ import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ..results import vtu
+
 from ..scene.schema import Scene
 
 
@@ -82,7 +84,8 @@ def load_state(root: Path) -> tuple[RunFiles, Scene, State, int]:
     """The run folder's files, scene, state and dimension as its checkpoint.json holds them."""
     files = RunFiles(root)
     if not files.checkpoint.is_file():
-        raise FileNotFoundError(f"{root}: no checkpoint.json to resume from")
+        raise FileNotFoundError(f"{root}: no checkpoint.json to resume from: the run stopped before it saved "
+                                f"its scene; start it again with `wendel run SCENE --out {root}`")
     data = json.loads(files.checkpoint.read_text())
     scene = Scene.model_validate(data["scene"])
     state = State(accepted=[tuple(a) for a in data["accepted"]], pending=data["pending"], cuts=data["cuts"],
@@ -90,3 +93,16 @@ def load_state(root: Path) -> tuple[RunFiles, Scene, State, int]:
                   segments=data["segments"], remeshes=data["remeshes"], reequilibrate=data["reequilibrate"],
                   quality={int(k): v for k, v in data["quality"].items()}, step=data["step"])
     return files, scene, state, data["dimension"]
+
+
+def committed(inc_dir: Path) -> dict | None:
+    """The record of increment folder ``inc_dir`` if FreeFEM committed it whole (its `done` marker, a
+    readable record.json and every array file complete), else None."""
+    if not (inc_dir / "done").is_file():
+        return None
+    try:
+        record = json.loads((inc_dir / "record.json").read_text())
+    except (OSError, ValueError):
+        return None
+    arrays = [p for p in inc_dir.glob("*.txt")]
+    return record if all(vtu.complete_array(p) for p in arrays) else None

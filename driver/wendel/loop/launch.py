@@ -9,6 +9,7 @@ problems (:class:`wendel.scene.blocks.Problem`) name their own entry script and 
 from __future__ import annotations
 
 from ..meshes import LABELS
+from ..scene import axisymmetric
 from ..scene.blocks import BLOCKS, PROBLEMS
 from ..scene.schema import ANALYTIC_REFERENCES, BODY_FORCES, Scene
 from .checkpoint import RunFiles
@@ -43,9 +44,10 @@ def macros(scene: Scene, dimension: int) -> list[str]:
     """
     if scene.problem != "mechanics":
         return [f"-D{m}=1" for m in PROBLEMS[scene.problem].macros]
-    switches = [f"-Ddimension={dimension}", f"-DPk={ELEMENT}"]
+    switches = [f"-Ddimension={dimension}", f"-DPk={axisymmetric.element(scene, dimension) or ELEMENT}"]
     switches += [f"-D{BLOCKS[name].macro}=1" for name in scene.blocks if BLOCKS[name].macro]
     # a switch that depends on a key rather than on a block goes here: switches.append("-DNAME=1") when on
+    switches += axisymmetric.macros(scene, dimension)
     if getattr(scene, "contact", None) is not None and scene.contact.current_configuration:
         switches.append("-DWITHFRICTION=1")      # friction, tool, path or force control: edp/lib/friction.idp
     return switches
@@ -63,6 +65,7 @@ def options(scene: Scene, files: RunFiles, dimension: int, segment: dict | None 
     opts += ["-mat_E", repr(m.E), "-mat_nu", repr(m.nu),
              "-el_plane_stress", "1" if scene.elasticity.plane == "stress" else "0",
              "-bc", str(files.tables / "bc.txt"), "-trac", str(files.tables / "trac.txt")]
+    opts += axisymmetric.options(scene, dimension)
     for key in ("ubase", "eps0"):
         if segment.get(key):
             opts += [f"-{key}", str(files.root / segment[key])]

@@ -8,7 +8,6 @@ the progress lines in :mod:`.progress`, the remesh step in :mod:`wendel.remesh.s
 from __future__ import annotations
 
 import contextlib
-import errno
 import json
 import shutil
 import tempfile
@@ -16,14 +15,16 @@ import time
 from pathlib import Path
 
 from .. import freefem
-from ..errors import DiskFull, Interrupted, RunFolderError
+from ..errors import DiskFull, RunFolderError
 from ..meshes import build as build_mesh
+from ..remesh import batch as remesh_batch
 from ..remesh.step import finish_report, judge, maybe_remesh
 from ..results import pictures, summary, vtu
 from ..scene import load
 from ..scene.reading import check_size
 from ..scene.schema import Scene
-from .checkpoint import RunFiles, State, load_state, save as _save_checkpoint
+from .checkpoint import RunFiles, State, committed, load_state, save as _save_checkpoint
+from .guard import disk_full as _disk_full, guarded
 from .launch import entry_script, macros, options, write_tables
 from .progress import _Progress
 from .steps import cut_step, grow_step, plan_step
@@ -87,39 +88,19 @@ def run_scene(scene: Scene, scene_path: Path, out: Path, smoke: bool = False, pr
         return _execute(scene, files, state, progress)
 
 
-@contextlib.contextmanager
-def guarded(root: Path):
-    """Name the run folder when a run stops short: Ctrl-C or SIGTERM (FreeFEM is stopped with the driver)
-    becomes :class:`Interrupted`, a full disk (of the driver's files or FreeFEM's) :class:`DiskFull`."""
-    try:
-        yield
-    except Interrupted:
-        raise
-    except KeyboardInterrupt:
-        raise Interrupted(root) from None
-    except OSError as exc:
-        if exc.errno == errno.ENOSPC:
-            raise DiskFull(root) from None
-        raise
-    except (freefem.FreeFemError, ValueError):
-        if _disk_full(root):
-            raise DiskFull(root) from None
-        raise
-
-
-def _disk_full(root: Path) -> bool:
-    """Whether the file system of ``root`` has (almost) no room left for another increment."""
-    try:
-        return shutil.disk_usage(root).free < 64 * 1024
-    except OSError:
-        return False
-
-
 def _execute(scene: Scene, files: RunFiles, state: State, progress) -> Path:
     """Solve the pending increments, then summary and picture."""
     dimension = json.loads(files.checkpoint.read_text())["dimension"]
     progress(f"wendel: {scene.description}")
     progress(f"  run folder {files.root}")
+    # the picture process starts its renderer while FreeFEM solves
+    with pictures.Painter(pictures.renderer(files.mesh)) if scene.output.png else contextlib.nullcontext() as painter:
+        _solve_and_report(scene, files, state, dimension, progress, painter)
+    return files.root
+
+
+def _solve_and_report(scene: Scene, files: RunFiles, state: State, dimension: int, progress, painter) -> None:
+    """Solve, write summary.json, then the picture (the run's critical path waits for the render only)."""
     try:
         segment = state.segments[-1]
         after_reequilibration = len(state.segments) > 1 and state.last[0] == segment["first"]
@@ -134,16 +115,14 @@ def _execute(scene: Scene, files: RunFiles, state: State, progress) -> Path:
         t0 = time.perf_counter()
         inc, lf = state.last
         if scene.output.vtu:
-            pictures.picture(files.vtu / f"inc-{inc:04d}.vtu", files.root / "deformed.png", f"load factor {lf:g}",
-                             scene.output.warp)
+            painter.paint(files.vtu / f"inc-{inc:04d}.vtu", files.root / "deformed.png", f"load factor {lf:g}",
+                          scene.output.warp)
         else:            # no VTU series: the picture is made from a VTU of the last increment that is not kept
             with tempfile.TemporaryDirectory() as tmp:
                 _write_increment_vtu(files, state, dimension, inc, Path(tmp) / "last.vtu")
-                pictures.picture(Path(tmp) / "last.vtu", files.root / "deformed.png", f"load factor {lf:g}",
-                                 scene.output.warp)
-        state.post_seconds += time.perf_counter() - t0
-        summary.write_summary(files.root, scene, state, dimension)
-    return files.root
+                painter.paint(Path(tmp) / "last.vtu", files.root / "deformed.png", f"load factor {lf:g}",
+                              scene.output.warp)
+        summary.write_summary(files.root, scene, state, dimension, picture=time.perf_counter() - t0)
 
 
 def _write_increment_vtu(files: RunFiles, state: State, dimension: int, inc: int, path: Path) -> None:
@@ -169,8 +148,8 @@ def build(scene: Scene, files: RunFiles) -> tuple[float, int]:
 def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress) -> None:
     """Launch FreeFEM on the pending increments; cut failing steps; remesh when the mesh distorts.
 
-    Without remeshing one launch runs all pending increments (start-up paid once); with remeshing each
-    launch runs one increment so that the driver judges the mesh after every increment.
+    Without remeshing one launch runs all pending increments (start-up paid once); with remeshing one
+    launch runs a remeshing segment (FreeFEM ends it after a poor mesh, :mod:`wendel.remesh.batch`).
     """
     write_tables(scene, files, dimension)
     entry = entry_script(scene, dimension)
@@ -179,8 +158,9 @@ def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress)
         inc0 = state.last[0] + 1
         if scene.loading.adaptive and not state.reequilibrate:
             plan_step(scene, state)
-        one_by_one = scene.remesh is not None or scene.loading.adaptive
-        batch = state.pending[:1] if one_by_one else list(state.pending)
+        was_reequilibration = state.reequilibrate
+        batch, stop_args = remesh_batch.plan(scene, state, dimension)
+        (files.fem / remesh_batch.STOP_FILE).unlink(missing_ok=True)
         loads = files.tables / "loads.txt"
         loads.write_text(f"{len(batch)}\n" + "".join(f"{lf!r}\n" for lf in batch))
         seg = state.segment(inc0)
@@ -193,7 +173,7 @@ def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress)
         failure, before, t0 = None, len(state.accepted), time.perf_counter()
         try:
             with watcher:
-                freefem.run(entry, switches + opts, files.fem, ranks=scene.numerics.ranks,
+                freefem.run(entry, switches + stop_args + opts, files.fem, ranks=scene.numerics.ranks,
                             timeout=scene.numerics.timeout, log=files.root / "freefem.log")
         except freefem.NewtonFailure as exc:
             failure = exc
@@ -201,7 +181,11 @@ def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress)
             accept(scene, files, state, dimension)
             state.launches.append({"wall": time.perf_counter() - t0, "increments": len(state.accepted) - before,
                                    "complete": failure is None})
-        if failure is None and len(state.accepted) - before < len(batch):
+        stopped = bool(stop_args) and remesh_batch.settle(scene, files, state, dimension, inc0, progress)
+        failure = None if stopped else failure
+        if state.reequilibrate and state.accepted and state.last[0] >= state.segments[-1]["first"]:
+            _reequilibrated(files, state, progress)     # (the launch may go on past the re-equilibration)
+        if failure is None and len(state.accepted) - before < len(batch) and not stopped:
             if _disk_full(files.root):
                 raise DiskFull(files.root)
             raise freefem.FreeFemError(f"FreeFEM ended without committing increment {state.last[0] + 1} whole "
@@ -210,11 +194,10 @@ def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress)
             cut_step(scene, files, state, failure, progress)
             _save_checkpoint(files, scene, state, dimension)
             continue
-        if scene.loading.adaptive and not state.reequilibrate:
+        if scene.loading.adaptive and not was_reequilibration:
             grow_step(scene, state, files)
-        if state.reequilibrate:
-            _reequilibrated(files, state, progress)
-        elif scene.remesh and state.pending:
+        if scene.remesh and state.pending and not (was_reequilibration
+                                                   and state.last[0] == state.segments[-1]["first"]):
             maybe_remesh(scene, files, state, dimension, progress)
         _save_checkpoint(files, scene, state, dimension)
 
@@ -223,23 +206,10 @@ def _reequilibrated(files: RunFiles, state: State, progress) -> None:
     """The increment on a new mesh is accepted: the remesh is complete (its report gets the residuals)."""
     state.reequilibrate = False
     rep = state.remeshes[-1]
-    finish_report(rep, files.fem / f"inc-{state.last[0]:04d}",
+    finish_report(rep, files.fem / f"inc-{state.segments[-1]['first']:04d}",
                   files.root / "remesh" / f"remesh-{len(state.remeshes)}.json")
     progress(f"  re-equilibrated on the new mesh: relative residual {rep['residual_after_transfer']:.2e}"
              f" -> {rep['residual_after_reequilibration']:.2e}")
-
-
-def committed(inc_dir: Path) -> dict | None:
-    """The record of increment folder ``inc_dir`` if FreeFEM committed it whole (its `done` marker, a
-    readable record.json and every array file complete), else None."""
-    if not (inc_dir / "done").is_file():
-        return None
-    try:
-        record = json.loads((inc_dir / "record.json").read_text())
-    except (OSError, ValueError):
-        return None
-    arrays = [p for p in inc_dir.glob("*.txt")]
-    return record if all(vtu.complete_array(p) for p in arrays) else None
 
 
 def accept(scene: Scene, files: RunFiles, state: State, dimension: int) -> None:

@@ -45,10 +45,11 @@ def _freefem_version() -> str:
 
 def write_provenance(root: Path, scene_path: Path, scene, smoke: bool) -> None:
     """The scene as run and where it ran: commit, versions, command line, host, start time."""
-    shutil.copyfile(scene_path, root / "scene.toml")
-    tmp = root / "scene.resolved.json.tmp"      # atomic: a run stopped before its checkpoint restarts from it
+    # first and atomically: a run stopped before its first checkpoint restarts from it (wendel run --resume)
+    tmp = root / "scene.resolved.json.tmp"
     tmp.write_text(json.dumps(scene.model_dump(mode="json"), indent=1))
     os.replace(tmp, root / "scene.resolved.json")
+    shutil.copyfile(scene_path, root / "scene.toml")
     versions = {"wendel": __version__, "python": sys.version.split()[0], "freefem++": _freefem_version()}
     for pkg in ("gmsh", "meshio", "numpy", "scipy", "pydantic", "pyvista", "matplotlib"):
         try:
@@ -101,8 +102,9 @@ def read_records(root: Path) -> list[dict]:
             for d in sorted((root / "fem").glob("inc-*")) if (d / "done").is_file()]
 
 
-def write_summary(root: Path, scene, state, dimension: int) -> dict:
-    """summary.json: fingerprints of the last increment and wall time by phase."""
+def write_summary(root: Path, scene, state, dimension: int, picture: float | None = None) -> dict:
+    """summary.json: fingerprints of the last increment and wall time by phase (``picture``: the seconds
+    the run waited for deformed.png, its own phase)."""
     records = read_records(root)
     phases = {"mesh": state.mesh_seconds, "freefem_startup": 0.0, "assembly": 0.0, "linear_solve": 0.0,
               "constitutive": 0.0, "freefem_output": 0.0, "freefem_other": 0.0,
@@ -126,6 +128,8 @@ def write_summary(root: Path, scene, state, dimension: int) -> dict:
         phases["freefem_other"] += inner - rec["time_assembly"] - rec["time_solve"] - rec["time_constitutive"] - rec["time_output"]
     failed_wall = sum(l["wall"] for l, r in by_launch if r is None)
     phases["failed_launches"] = failed_wall
+    if picture is not None:
+        phases["picture"] = picture
     total = sum(phases.values())
     last = records[-1] if records else {}
     summary = {
@@ -144,7 +148,8 @@ def write_summary(root: Path, scene, state, dimension: int) -> dict:
         "solver": last.get("solver"),
         "wall_time": total,
         "wall_time_by_phase": phases,
-        "share_startup_and_io": (phases["freefem_startup"] + phases["freefem_output"] + phases["driver_output"]) / total
+        "share_startup_and_io": (phases["freefem_startup"] + phases["freefem_output"] + phases["driver_output"]
+                                 + phases.get("picture", 0.0)) / total
         if total else None,
         "remeshes": state.remeshes,
         "errors": _errors(last),

@@ -14,6 +14,7 @@ True
 from __future__ import annotations
 
 import copy
+import inspect
 import math
 import tomllib
 from pathlib import Path
@@ -21,7 +22,7 @@ from pathlib import Path
 from pydantic import ValidationError
 
 from ..meshes import LABELS
-from ..meshes.builders import BOUNDARIES
+from ..meshes.builders import BOUNDARIES, BUILDERS
 from ..meshes.check import inspect_file
 from ..meshes.params import estimate_elements, validate as validate_builder
 from .schema import Scene
@@ -106,10 +107,19 @@ def check_size(scene: Scene, source: str) -> None:
     if g.builder is not None:
         est = estimate_elements(g.builder, validate_builder(g.builder, g.params))
         if est is not None and est > n.max_elements:
+            # the sizes the estimate used, defaults included (a deleted radius falls back to its default)
+            sig = inspect.signature(BUILDERS[g.builder]).parameters
+            sizes = {k: v.default for k, v in sig.items() if k not in ("path", "h", "refine")
+                     and isinstance(v.default, (int, float, tuple)) and not isinstance(v.default, bool)}
+            sizes.update({k: v for k, v in g.params.items() if k in sizes})
+            used = ", ".join(f"{k} = {list(v) if isinstance(v, tuple) else v}" for k, v in sizes.items())
+            refine = g.params.get("refine")
+            if refine:
+                used += f", refined zone {', '.join(f'{k} = {v}' for k, v in refine.items())}"
             raise SceneError(
                 f"{source}: geometry.h: the mesh would have about {est:.2g} elements (estimated from h = {g.h:g} "
-                f"and the geometry), above numerics.max_elements = {n.max_elements:.3g}: use a larger h, or "
-                f"raise numerics.max_elements if this machine can hold it")
+                f"and the geometry: {used}), above numerics.max_elements = {n.max_elements:.3g}: use a larger h, "
+                f"or raise numerics.max_elements if this machine can hold it")
     loading = scene.loading
     count, key = (len(loading.factors), "loading.factors") if loading.factors else (loading.steps, "loading.steps")
     if count > n.max_increments:
@@ -125,9 +135,13 @@ def _indicator(scene: Scene, source: str) -> None:
         return
     valid = list(CELL_FIELDS) + [
         f for name in scene.blocks for f in BLOCKS[name].fields if f in BLOCK_CELL_FIELDS]
+    if scene.elasticity.plane == "axisymmetric":
+        valid.append("strain_hoop")            # the hoop strain of (r, z) models (edp/lib/mechanics.idp)
     if scene.remesh.indicator not in valid:
+        writers = [f"[{name}]" for name, b in BLOCKS.items() if scene.remesh.indicator in b.fields]
+        why = f" (it is written by {' or '.join(writers)}, which this scene does not have)" if writers else ""
         raise SceneError(f"{source}: remesh.indicator: {scene.remesh.indicator!r} is not a cell field of this "
-                         f"scene; valid: {', '.join(valid)} (or \"\" for a uniform size)")
+                         f"scene{why}; valid: {', '.join(valid)} (or \"\" for a uniform size)")
 
 
 def load(path: str | Path, smoke: bool = False) -> Scene:

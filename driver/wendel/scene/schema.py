@@ -20,6 +20,7 @@ from pydantic import BaseModel, ConfigDict, Field, create_model, field_validator
 from .blocks import BLOCKS, PROBLEMS, choice, load_all
 from ..results.comparisons import COMPARISONS
 from ..meshes import BUILDERS
+from .axisymmetric import REFERENCES as AXI_REFERENCES, check as check_axisymmetric
 
 # Names a scene may use, mapped to the integer ids of edp/lib/loads.idp (never code).
 BODY_FORCES = {"none": 0, "constant": 1, "step8-discs": 2, "manufactured": 3}
@@ -30,6 +31,7 @@ BodyForceName = choice(BODY_FORCES, "body force")
 SolverName = choice(SOLVERS, "solver")
 AnalyticName = choice(ANALYTIC_REFERENCES, "analytic reference")
 ComparisonName = choice(COMPARISONS, "comparison")
+AxiReferenceName = choice(AXI_REFERENCES, "axisymmetric reference")
 
 
 class Strict(BaseModel):
@@ -82,7 +84,12 @@ class Material(Strict):
 class Elasticity(Strict):
     """Options of the elastic part (present in every mechanical scene)."""
 
-    plane: Literal["strain", "stress"] = Field("strain", description="2D hypothesis")
+    plane: Literal["strain", "stress", "axisymmetric"] = Field(
+        "strain", description="2D hypothesis; axisymmetric: x = r >= 0, y = z, hoop strain and 2 pi r weights")
+    order: int = Field(1, ge=1, le=2, description="Lagrange order of the displacement; 2: 2D elastic scenes "
+                       "without remeshing (-DPk=P2)")
+    reference: Optional[AxiReferenceName] = Field(
+        None, description=f"closed form of an axisymmetric scene: {', '.join(AXI_REFERENCES)}")
 
 
 class Boundary(Strict):
@@ -258,6 +265,8 @@ class SceneBase(Strict):
                 block.check(getattr(self, name), self)
         if self.body_force.kind == "manufactured" and self.reference.analytic is None:
             raise ValueError("body_force.kind = \"manufactured\" needs reference.analytic")
+        if self.problem == "mechanics":
+            check_axisymmetric(self)       # elasticity.plane/order/reference against the other tables
         return self
 
     @property
