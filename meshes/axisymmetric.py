@@ -4,8 +4,8 @@ FreeFEM pins u_r = 0 on ``axis`` by itself (edp/lib/axisymmetric-mechanics.idp);
 named as in the plane builders.
 
 >>> from meshes.builders import BUILDERS
->>> sorted(n for n in BUILDERS if n.startswith("axi") or n.endswith("section") or n == "notched_bar")
-['axi_rectangle', 'hollow_cylinder_section', 'notched_bar', 'sphere_section']
+>>> {"axi_rectangle", "hollow_cylinder_section", "notched_bar", "sphere_section"} <= set(BUILDERS)
+True
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from .builders import Built, _Session, _size_field, _write, register
+from .builders import Built, _Session, _size_field, _write, rectangle_sizes, register
 from .labels import LABELS
 
 
@@ -35,18 +35,7 @@ def axi_rectangle(path: Path, r=(0.0, 1.0), z=(0.0, 1.0), h=0.1, refine=None, st
     """A rectangle [r0, r1] x [z0, z1] (m) of an (r, z) section: boundaries axis (r = 0; ``left`` when
     r0 > 0), right, bottom, top. ``structured=True``: a transfinite mesh (convergence studies)."""
     with _Session("axi_rectangle") as gmsh:
-        occ = gmsh.model.occ
-        occ.addRectangle(r[0], z[0], 0.0, r[1] - r[0], z[1] - z[0])
-        occ.synchronize()
-        if structured:
-            for _, c in gmsh.model.getEntities(1):
-                bb = gmsh.model.getBoundingBox(1, c)
-                length = max(bb[3] - bb[0], bb[4] - bb[1])
-                gmsh.model.mesh.setTransfiniteCurve(c, max(2, round(length / h) + 1))
-            for _, s in gmsh.model.getEntities(2):
-                gmsh.model.mesh.setTransfiniteSurface(s)
-        else:
-            _size_field(gmsh, h, refine)
+        rectangle_sizes(gmsh, r, z, h, refine, structured)
         tol = 1e-6 * max(r[1] - r[0], z[1] - z[0])
 
         def classify(px, py):

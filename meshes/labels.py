@@ -21,6 +21,8 @@ LABELS = {
     "symmetry_y": 12,  # plane y = 0 of a symmetric model
     "free_surface": 21,  # orthogonal cutting: the uncut surface that becomes the chip's back
     "machined": 22,      # orthogonal cutting: the machined surface behind the tool
+    "bore_wall": 23,   # cylindrical wall of a drilled bore (meshes/drilling.py)
+    "bore_bottom": 24,  # tip cone at the bottom of a drilled bore
     "domain": 100,  # the body itself
 }
 

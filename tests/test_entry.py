@@ -24,9 +24,10 @@ from conftest import WORKFLOWS
 GUARDS = {"plasticity": "wendelPlasticityIdp", "contact": "wendelContactIdp", "thermal": "wendelThermalIdp",
           "thermal-fields": "wendelThermalFieldsIdp", "elasticity": "wendelElasticityIdp",
           "axisymmetric": "wendelAxisymmetricIdp", "axisymmetric-mechanics": "wendelAxisymmetricMechanicsIdp",
-          "remeshstop": "wendelRemeshStopIdp", "friction": "wendelFrictionIdp", "tool": "wendelToolIdp"}
-MODULES = ("plasticity", "contact", "thermal", "thermal-fields", "axisymmetric", "axisymmetric-mechanics", "remeshstop", "friction",
-           "tool")
+          "remeshstop": "wendelRemeshStopIdp", "kinematics": "wendelKinematicsIdp",
+          "friction": "wendelFrictionIdp", "tool": "wendelToolIdp"}
+MODULES = ("plasticity", "contact", "thermal", "thermal-fields", "axisymmetric", "axisymmetric-mechanics", "remeshstop",
+           "kinematics", "friction", "tool")
 
 
 def compiled(tmp_path, scene_name: str) -> tuple[set[str], list[str], dict]:
@@ -67,6 +68,11 @@ def test_each_block_compiles_its_module_and_only_it(tmp_path, scene_name, module
     found, switches, _ = compiled(tmp_path, scene_name)
     assert found & set(MODULES) == modules, found
     assert {f"-DWITH{m.upper()}=1" for m in modules if m not in ("thermal-fields", "tool")} <= set(switches)
+
+
+def test_updated_lagrangian_kinematics_is_compiled_only_when_the_scene_asks(tmp_path):
+    found, switches, _ = compiled(tmp_path, "ul-tension.toml")
+    assert found & set(MODULES) == {"plasticity", "kinematics"} and "-DUPDATEDLAGRANGIAN=1" in switches
 
 
 def test_a_value_of_zero_still_switches_a_module_on(tmp_path):

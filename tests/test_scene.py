@@ -7,12 +7,7 @@ import pytest
 from wendel.cli import main
 from wendel.scene import SceneError, load
 
-from conftest import SMOKE_SCENE
-
-
-def edit(text: str, old: str, new: str) -> str:
-    assert old in text, old
-    return text.replace(old, new, 1)
+from conftest import edit, SMOKE_SCENE
 
 
 BAD = [

@@ -70,10 +70,12 @@ def main(argv: list[str] | None = None) -> int:
     p = sub.add_parser("keys", help="print the scene keys (type, default, unit, range) as a Markdown table")
     p.add_argument("--update", type=Path, metavar="README", help="rewrite the table in this file instead")
 
-    p = sub.add_parser("bench", help="benchmarks; results into results/bench/")
-    p.add_argument("names", nargs="*", help="benchmarks to run: axisymmetric, cylinder, elasticity, friction, obstacle, "
-                   "remesh, step42, sweep, thermal, the analytic cut's oxley, oxley-domain and oxley-kienzle "
-                   "(the default: all of these), step42-dealii, overhead, gmsh3d (only when named)")
+    p = sub.add_parser("bench", help="benchmarks; results into results/bench/",
+                       formatter_class=argparse.RawTextHelpFormatter)     # names are not wrapped at hyphens
+    p.add_argument("names", nargs="*", help="benchmarks to run (default: all of these):\n"
+                   "  axisymmetric, cylinder, drilling, elasticity, friction, obstacle, remesh, step42, sweep, thermal, ul,\n"
+                   "  oxley, oxley-domain, oxley-kienzle (the analytic orthogonal cut);\n"
+                   "only when named: step42-dealii, overhead, gmsh3d")
     p.add_argument("--quick", action="store_true", help="small sizes only")
 
     p = sub.add_parser("sweep", help="campaigns: a plan of runs, locally or on SLURM (see wendel.sweep)")

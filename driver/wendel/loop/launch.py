@@ -48,6 +48,8 @@ def macros(scene: Scene, dimension: int) -> list[str]:
     switches += [f"-D{BLOCKS[name].macro}=1" for name in scene.blocks if BLOCKS[name].macro]
     # a switch that depends on a key rather than on a block goes here: switches.append("-DNAME=1") when on
     switches += axisymmetric.macros(scene, dimension)
+    if scene.kinematics.updated_lagrangian:
+        switches.append("-DUPDATEDLAGRANGIAN=1")     # edp/lib/kinematics.idp
     if getattr(scene, "contact", None) is not None and scene.contact.current_configuration:
         switches.append("-DWITHFRICTION=1")      # friction, tool, path or force control: edp/lib/friction.idp
     return switches
@@ -66,9 +68,12 @@ def options(scene: Scene, files: RunFiles, dimension: int, segment: dict | None 
              "-el_plane_stress", "1" if scene.elasticity.plane == "stress" else "0",
              "-bc", str(files.tables / "bc.txt"), "-trac", str(files.tables / "trac.txt")]
     opts += axisymmetric.options(scene, dimension)
-    for key in ("ubase", "eps0"):
-        if segment.get(key):
+    for key in ("ubase", "eps0"):      # updated Lagrangian: the strain is state (ul_eps.qp.txt), no pre-strain
+        if segment.get(key) and not (key == "eps0" and scene.kinematics.updated_lagrangian):
             opts += [f"-{key}", str(files.root / segment[key])]
+    if (files.tables / "motion.txt").is_file():
+        opts += ["-bc_motion", str(files.tables / "motion.txt")]
+    opts += kinematics_options(scene)
     bf = scene.body_force
     v = list(bf.value) + [0.0] * (3 - len(bf.value))
     opts += ["-body_id", str(BODY_FORCES[bf.kind]), "-body_fx", repr(v[0]), "-body_fy", repr(v[1]),
@@ -80,12 +85,25 @@ def options(scene: Scene, files: RunFiles, dimension: int, segment: dict | None 
     return opts
 
 
+def kinematics_options(scene: Scene) -> list[str]:
+    """Updated-Lagrangian kinematics (edp/lib/kinematics.idp, compiled by the -D switch of :func:`macros`)."""
+    k = scene.kinematics
+    if not k.updated_lagrangian:
+        return []
+    e = k.initial_strain
+    return ["-ul_min_jacobian", repr(k.min_area_ratio),
+            "-ul_eps_xx", repr(e[0]), "-ul_eps_yy", repr(e[1]), "-ul_eps_xy", repr(e[2])]
+
+
 def write_tables(scene: Scene, files: RunFiles, dimension: int) -> None:
     """Boundary condition tables for bc.idp (labels from meshes/labels.py)."""
     files.tables.mkdir(parents=True, exist_ok=True)
-    dirichlet, neumann = [], []
+    dirichlet, neumann, motion = [], [], []
     for name, b in scene.boundary.items():
         lab = LABELS[name]
+        if b.motion:
+            g = b.gradient or [0.0] * 4
+            motion.append(f"{lab} " + " ".join(repr(float(v)) for v in [b.rotation or 0.0, *g, *b.center]))
         for comp, val in enumerate((b.ux, b.uy, b.uz)):
             if val is not None:
                 if comp == 2 and dimension == 2:
@@ -96,3 +114,5 @@ def write_tables(scene: Scene, files: RunFiles, dimension: int) -> None:
             neumann.append(f"{lab} {t[0]!r} {t[1]!r} {t[2]!r} {float(b.pressure or 0.0)!r}")
     (files.tables / "bc.txt").write_text(f"{len(dirichlet)}\n" + "".join(r + "\n" for r in dirichlet))
     (files.tables / "trac.txt").write_text(f"{len(neumann)}\n" + "".join(r + "\n" for r in neumann))
+    if motion:
+        (files.tables / "motion.txt").write_text(f"{len(motion)}\n" + "".join(r + "\n" for r in motion))

@@ -24,7 +24,7 @@ from ..scene import load
 from ..scene.reading import check_size
 from ..scene.schema import Scene
 from .checkpoint import RunFiles, State, committed, load_state, save as _save_checkpoint
-from .guard import disk_full as _disk_full, guarded
+from .guard import disk_full as _disk_full, guarded, stop_leftovers
 from .launch import entry_script, macros, options, write_tables
 from .progress import _Progress
 from .steps import cut_step, grow_step, plan_step
@@ -80,6 +80,10 @@ def run_scene(scene: Scene, scene_path: Path, out: Path, smoke: bool = False, pr
     except OSError as exc:
         raise RunFolderError(f"run folder (--out) {out}: cannot be created or written: {exc.strerror}") from None
     check_size(scene, str(scene_path))       # h may have been scaled since the scene was read (studies)
+    if getattr(scene, "drilling", None) is not None:      # a process of removal steps: wendel.loop.drilling
+        from .drilling import run as run_drilling
+        with guarded(files.root):
+            return run_drilling(scene, scene_path, files.root, smoke, progress)
     with guarded(files.root):
         summary.write_provenance(files.root, Path(scene_path), scene, smoke)
         state = State(pending=scene.loading.load_factors())
@@ -116,19 +120,23 @@ def _solve_and_report(scene: Scene, files: RunFiles, state: State, dimension: in
         inc, lf = state.last
         if scene.output.vtu:
             painter.paint(files.vtu / f"inc-{inc:04d}.vtu", files.root / "deformed.png", f"load factor {lf:g}",
-                          scene.output.warp)
+                          scene.output.warp, deformed=scene.kinematics.updated_lagrangian)
         else:            # no VTU series: the picture is made from a VTU of the last increment that is not kept
             with tempfile.TemporaryDirectory() as tmp:
-                _write_increment_vtu(files, state, dimension, inc, Path(tmp) / "last.vtu")
+                _write_increment_vtu(files, state, dimension, inc, Path(tmp) / "last.vtu",
+                                     scene.kinematics.updated_lagrangian)
                 painter.paint(Path(tmp) / "last.vtu", files.root / "deformed.png", f"load factor {lf:g}",
-                              scene.output.warp)
+                              scene.output.warp, deformed=scene.kinematics.updated_lagrangian)
         summary.write_summary(files.root, scene, state, dimension, picture=time.perf_counter() - t0)
 
 
-def _write_increment_vtu(files: RunFiles, state: State, dimension: int, inc: int, path: Path) -> None:
+def _write_increment_vtu(files: RunFiles, state: State, dimension: int, inc: int, path: Path,
+                         updated_lagrangian: bool = False) -> None:
     """The VTU of accepted increment ``inc`` at ``path``."""
     points, cells = vtu.read_mesh(files.root / state.segment(inc)["mesh"], dimension)
     pdata, cdata = vtu.increment_fields(files.fem / f"inc-{inc:04d}", len(points), len(cells), dimension)
+    if updated_lagrangian:      # the VTU is the deformed body itself (points = current positions)
+        points = vtu.current_points(pdata, points)
     vtu.write_vtu(path, points, cells, dimension, pdata, cdata)
 
 
@@ -239,7 +247,9 @@ def accept(scene: Scene, files: RunFiles, state: State, dimension: int) -> None:
         if scene.output.vtu:
             pdata, cdata = vtu.increment_fields(d, len(points), len(cells), dimension)
             files.vtu.mkdir(exist_ok=True)
-            vtu.write_vtu(files.vtu / f"inc-{inc:04d}.vtu", points, cells, dimension, pdata, cdata)
+            # updated-Lagrangian: the VTU is the deformed body itself (points = current positions)
+            at = vtu.current_points(pdata, points) if scene.kinematics.updated_lagrangian else points
+            vtu.write_vtu(files.vtu / f"inc-{inc:04d}.vtu", at, cells, dimension, pdata, cdata)
         state.accepted.append((inc, record["load_factor"]))
         state.pending.pop(0)
         summary.append_history(files.root, {**record, **extra}, d / "newton.csv")
@@ -284,6 +294,8 @@ def _restart(root: Path, progress) -> Path:
 
 def _resume(root: Path, progress=print) -> tuple[RunFiles, Scene, State]:
     files, scene, state, dimension = load_state(root)
+    if stop_leftovers(files.fem):
+        progress(f"  stopped a FreeFEM launch of {root} that outlived its driver")
     # An increment committed after the last checkpoint is taken as it is; a partial one is dropped.
     summary.truncate_history(files.root, state.last[0])
     accept(scene, files, state, dimension)

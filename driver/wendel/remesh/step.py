@@ -85,13 +85,17 @@ def yield_violation(eps0: np.ndarray, epsp: np.ndarray, sigma_y: np.ndarray, mu:
 
 def remesh_state(inc_dir: Path, mesh_old: Path, ubase_old: np.ndarray | None, dimension: int,
                  mesh_new: Path, state_new: Path, h: float, h_min: float, indicator: str,
-                 mu: float | None = None, axisymmetric: bool = False) -> dict:
+                 mu: float | None = None, axisymmetric: bool = False, make_mesh=None,
+                 deformed: bool = True) -> dict:
     """Mesh the deformed body of increment ``inc_dir`` anew and write the transferred state.
 
     Writes ``mesh_new`` and, in ``state_new``, ``u.node.txt`` (zeros), ``ubase.txt``, ``eps0.txt`` and the
     module state files; returns the transfer report (without the re-equilibration residuals).
     ``axisymmetric``: (r, z) meshes: recoveries and integrals with the volumes of revolution, the hoop strain
     carried in ``eps0``.
+    ``make_mesh`` replaces :func:`wendel.remesh.mesher.remesh` (same arguments and report keys), e.g. the material
+    removal of :mod:`wendel.drilling`; ``deformed = False`` transfers in the reference configuration
+    (small strain: the new mesh is made from the original geometry).
     """
     from . import mesher, transfer
 
@@ -100,14 +104,14 @@ def remesh_state(inc_dir: Path, mesh_old: Path, ubase_old: np.ndarray | None, di
     X = X[:, :dimension]
     n_old = len(X)
     u = vtu.read_array(inc_dir / "u.node.txt")
-    xd = X + u.reshape(n_old, dimension)
+    xd = X + u.reshape(n_old, dimension) if deformed else X
     before = quality.mesh_quality(xd, cells, reference=X)
     cellfield = lambda name: _cells(inc_dir / f"{name}.cell.txt", len(cells))
     size_ind = None
     if indicator and (inc_dir / f"{indicator}.cell.txt").is_file():
         size_ind = transfer.cell_to_nodes(xd, cells, cellfield(indicator)[:, 0], axisymmetric=axisymmetric)
     with _quiet_stdout():
-        info = mesher.remesh(xd, mesh_old, mesh_new, h, size_indicator=size_ind, h_min=h_min)
+        info = (make_mesh or mesher.remesh)(xd, mesh_old, mesh_new, h, size_indicator=size_ind, h_min=h_min)
     t1 = time.perf_counter()
     Y, new_cells = vtu.read_mesh(mesh_new, dimension)
     Y = Y[:, :dimension]

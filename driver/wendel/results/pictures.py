@@ -11,7 +11,8 @@ from pathlib import Path
 import numpy as np
 
 
-def picture(vtu: Path, png: Path, title: str, warp: float = 0.0, field: str | None = None) -> None:
+def picture(vtu: Path, png: Path, title: str, warp: float = 0.0, field: str | None = None,
+            deformed: bool = False) -> None:
     """Render the deformed body off-screen, coloured by ``field`` (von Mises by default)."""
     os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
     import pyvista as pv
@@ -34,8 +35,10 @@ def picture(vtu: Path, png: Path, title: str, warp: float = 0.0, field: str | No
         # body), magnified to 10% of the size for small ones
         large = umax >= 0.05 * size or "u_total" in grid.point_data
         scale = warp or (1.0 if large else 0.1 * size / umax)
+        if deformed:
+            scale = 0.0         # updated-Lagrangian VTU: the points are the deformed body already
         grid = grid.warp_by_vector("u", factor=scale)
-        title = f"{title} (displacement x{scale:.3g})"
+        title = f"{title} ({'current configuration' if deformed else f'displacement x{scale:.3g}'})"
     field = field or ("vonMises" if "vonMises" in grid.cell_data else None)
     plotter = pv.Plotter(off_screen=True, window_size=(900, 700))
     plotter.add_mesh(grid, scalars=field, show_edges=grid.n_cells < 20000, cmap="viridis",
@@ -63,10 +66,12 @@ def _faces(tets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return faces[keep], owner[keep]
 
 
-def quick_picture(vtu: Path, png: Path, title: str, warp: float = 0.0, field: str | None = None) -> None:
+def quick_picture(vtu: Path, png: Path, title: str, warp: float = 0.0, field: str | None = None,
+                  deformed: bool = False) -> None:
     """The deformed body drawn with matplotlib (0.6 s to start here, against 3 s for pyvista): a plane body
     as coloured triangles, a solid as its coloured boundary faces, a scalar ``u`` on a plane as the surface
-    z = u; coloured by ``field`` (von Mises by default) and scaled as :func:`picture` does."""
+    z = u; coloured by ``field`` (von Mises by default) and scaled as :func:`picture` does (``deformed``: the
+    points are the current configuration already, as in updated-Lagrangian runs)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -96,9 +101,10 @@ def quick_picture(vtu: Path, png: Path, title: str, warp: float = 0.0, field: st
         else:
             umax = float(np.abs(u).max()) or 1.0
             scale = warp or (1.0 if umax >= 0.05 * size or "u_total" in m.point_data else 0.1 * size / umax)
+            scale = 0.0 if deformed else scale
             xyz = points + scale * u[:, :3]
             faces, owner = _faces(cells)
-            what = f"displacement x{scale:.3g}"
+            what = "current configuration" if deformed else f"displacement x{scale:.3g}"
         from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
         ax = fig.add_subplot(projection="3d")
@@ -118,7 +124,7 @@ def quick_picture(vtu: Path, png: Path, title: str, warp: float = 0.0, field: st
         u = u[:, :2]
         umax = float(np.abs(u).max()) or 1.0
         large = umax >= 0.05 * size or "u_total" in m.point_data
-        scale = warp or (1.0 if large else 0.1 * size / umax)
+        scale = 0.0 if deformed else warp or (1.0 if large else 0.1 * size / umax)
         p = points[:, :2] + scale * u
         ax = fig.add_subplot()
         style = {"edgecolors": "k", "linewidth": 0.2} if len(cells) < 20000 else {}
@@ -129,7 +135,8 @@ def quick_picture(vtu: Path, png: Path, title: str, warp: float = 0.0, field: st
         else:
             ax.triplot(tri, color="k", linewidth=0.3)
         ax.set_aspect("equal")
-        ax.set_title(f"{title} (displacement x{scale:.3g})", fontsize=10)
+        ax.set_title(f"{title} ({'current configuration' if deformed else f'displacement x{scale:.3g}'})",
+                     fontsize=10)
     fig.savefig(png)
     plt.close(fig)
 
@@ -169,13 +176,13 @@ class Painter:
                                      stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True,
                                      start_new_session=True)
 
-    def paint(self, vtu: Path, png: Path, title: str, warp: float = 0.0) -> None:
+    def paint(self, vtu: Path, png: Path, title: str, warp: float = 0.0, deformed: bool = False) -> None:
         """Render ``vtu`` into ``png`` (as :func:`picture`); raise RuntimeError if the process could not."""
         import json
 
         try:
             self.proc.stdin.write(json.dumps({"vtu": str(vtu), "png": str(png), "title": title,
-                                              "warp": warp}) + "\n")
+                                              "warp": warp, "deformed": deformed}) + "\n")
             self.proc.stdin.flush()
             answer = self.proc.stdout.readline().strip()
         except OSError as exc:
@@ -223,7 +230,7 @@ def _serve() -> None:
     for line in sys.stdin:
         try:
             req = json.loads(line)
-            draw(Path(req["vtu"]), Path(req["png"]), req["title"], req["warp"])
+            draw(Path(req["vtu"]), Path(req["png"]), req["title"], req["warp"], deformed=req.get("deformed", False))
             answer = "ok"
         except Exception as exc:        # noqa: BLE001 - reported to the driver, which raises it
             answer = f"{type(exc).__name__}: {exc}".replace("\n", " ")

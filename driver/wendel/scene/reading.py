@@ -144,16 +144,20 @@ def _indicator(scene: Scene, source: str) -> None:
                          f"scene{why}; valid: {', '.join(valid)} (or \"\" for a uniform size)")
 
 
+def read_toml(path: Path, what: str = "scene") -> dict:
+    """The TOML file ``path`` (a ``what`` file) as a dict; SceneError naming the file otherwise."""
+    if not path.is_file():
+        raise SceneError(f"{path}: no such {what} file")
+    try:
+        return tomllib.loads(path.read_text())
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise SceneError(f"{path}: not valid TOML: {exc}") from None
+
+
 def load(path: str | Path, smoke: bool = False) -> Scene:
     """Read and validate the scene file ``path``; with ``smoke`` apply its [smoke] overrides."""
     path = Path(path)
-    if not path.is_file():
-        raise SceneError(f"{path}: no such scene file")
-    try:
-        data = tomllib.loads(path.read_text())
-    except tomllib.TOMLDecodeError as exc:
-        raise SceneError(f"{path}: not valid TOML: {exc}") from None
-    scene = parse(data, str(path))
+    scene = parse(read_toml(path), str(path))
     if scene.geometry.mesh is not None:
         mesh = (path.parent / scene.geometry.mesh).resolve()
         if not mesh.is_file():

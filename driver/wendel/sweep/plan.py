@@ -34,7 +34,6 @@ import hashlib
 import itertools
 import json
 import math
-import tomllib
 from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
@@ -44,6 +43,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 from .. import __version__
 from ..scene import SceneError, parse
+from ..scene.reading import read_toml
 
 SAMPLERS = {}
 
@@ -225,12 +225,7 @@ def folder_name(params: dict, digest: str) -> str:
 def load_sweep(path: str | Path) -> Sweep:
     """Read the sweep file, plan every run and validate every planned scene (SceneError names key and values)."""
     path = Path(path)
-    if not path.is_file():
-        raise SceneError(f"{path}: no such sweep file")
-    try:
-        raw = tomllib.loads(path.read_text())
-    except tomllib.TOMLDecodeError as exc:
-        raise SceneError(f"{path}: not valid TOML: {exc}") from None
+    raw = read_toml(path, "sweep")
     try:
         spec = SweepFile.model_validate(raw)
     except ValidationError as exc:
@@ -238,7 +233,7 @@ def load_sweep(path: str | Path) -> Sweep:
     scene_path = (path.parent / spec.scene).resolve()
     if not scene_path.is_file():
         raise SceneError(f"{path}: scene: no such scene file {scene_path}")
-    base = tomllib.loads(scene_path.read_text())
+    base = read_toml(scene_path)
     parse(base, str(scene_path))                              # the scene itself must be valid
     if spec.smoke:
         for k, v in (base.get("smoke") or {}).items():
