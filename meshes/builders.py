@@ -248,3 +248,26 @@ def disk(path: Path, radius=1.0, center=(0.0, 0.0), h=0.1) -> Built:
         gmsh.model.addPhysicalGroup(1, curves, LABELS["outer"], "outer")
         gmsh.model.addPhysicalGroup(2, [t for _, t in gmsh.model.getEntities(2)], LABELS["domain"], "domain")
         return _write(gmsh, path, 2, ["outer"])
+
+
+@register("parallelogram", ["left", "right", "bottom", "top"])
+def parallelogram(path: Path, x=(0.0, 1.0), y=(0.0, 1.0), slope=0.0, h=0.1) -> Built:
+    """The rectangle [x0, x1] x [y0, y1] (m) sheared vertically by ``slope`` (1): the point (x, y) moves to
+    (x, y + slope (x - x0)); a block resting on an incline of angle atan(slope). Boundaries left and right
+    (vertical), bottom and top (inclined)."""
+    names = ["left", "right", "bottom", "top"]
+    with _Session("parallelogram") as gmsh:
+        occ = gmsh.model.occ
+        rise = slope * (x[1] - x[0])
+        p = [occ.addPoint(x[0], y[0], 0), occ.addPoint(x[1], y[0] + rise, 0),
+             occ.addPoint(x[1], y[1] + rise, 0), occ.addPoint(x[0], y[1], 0)]
+        lines = {"bottom": occ.addLine(p[0], p[1]), "right": occ.addLine(p[1], p[2]),
+                 "top": occ.addLine(p[2], p[3]), "left": occ.addLine(p[3], p[0])}
+        loop = occ.addCurveLoop([lines["bottom"], lines["right"], lines["top"], lines["left"]])
+        surf = occ.addPlaneSurface([loop])
+        occ.synchronize()
+        _size_field(gmsh, h, None)
+        for n in names:
+            gmsh.model.addPhysicalGroup(1, [lines[n]], LABELS[n], n)
+        gmsh.model.addPhysicalGroup(2, [surf], LABELS["domain"], "domain")
+        return _write(gmsh, path, 2, names)

@@ -24,9 +24,10 @@ from conftest import WORKFLOWS
 GUARDS = {"plasticity": "wendelPlasticityIdp", "contact": "wendelContactIdp", "thermal": "wendelThermalIdp",
           "thermal-fields": "wendelThermalFieldsIdp", "elasticity": "wendelElasticityIdp",
           "axisymmetric": "wendelAxisymmetricIdp", "axisymmetric-mechanics": "wendelAxisymmetricMechanicsIdp",
-          "remeshstop": "wendelRemeshStopIdp", "kinematics": "wendelKinematicsIdp"}
+          "remeshstop": "wendelRemeshStopIdp", "kinematics": "wendelKinematicsIdp",
+          "friction": "wendelFrictionIdp", "tool": "wendelToolIdp"}
 MODULES = ("plasticity", "contact", "thermal", "thermal-fields", "axisymmetric", "axisymmetric-mechanics", "remeshstop",
-           "kinematics")
+           "kinematics", "friction", "tool")
 
 
 def compiled(tmp_path, scene_name: str) -> tuple[set[str], list[str], dict]:
@@ -61,11 +62,12 @@ def test_an_elastic_scene_compiles_no_plasticity_contact_or_thermal_code(tmp_pat
 @pytest.mark.parametrize("scene_name, modules", [
     ("ball-indent.toml", {"contact", "plasticity"}),
     ("thermo-indent.toml", {"contact", "plasticity", "thermal", "thermal-fields"}),
+    ("sliding-block.toml", {"contact", "friction", "tool"}),
 ])
 def test_each_block_compiles_its_module_and_only_it(tmp_path, scene_name, modules):
     found, switches, _ = compiled(tmp_path, scene_name)
     assert found & set(MODULES) == modules, found
-    assert {f"-DWITH{m.upper()}=1" for m in modules if m != "thermal-fields"} <= set(switches)
+    assert {f"-DWITH{m.upper()}=1" for m in modules if m not in ("thermal-fields", "tool")} <= set(switches)
 
 
 def test_updated_lagrangian_kinematics_is_compiled_only_when_the_scene_asks(tmp_path):

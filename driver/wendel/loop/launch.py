@@ -39,6 +39,8 @@ def macros(scene: Scene, dimension: int) -> list[str]:
     ['-Ddimension=2', '-DPk=P1']
     >>> macros(load(ROOT / "workflows" / "ball-indent.toml"), 3)
     ['-Ddimension=3', '-DPk=P1', '-DWITHCONTACT=1', '-DWITHPLASTICITY=1']
+    >>> macros(load(ROOT / "workflows" / "sliding-block.toml"), 2)[-1]
+    '-DWITHFRICTION=1'
     """
     if scene.problem != "mechanics":
         return [f"-D{m}=1" for m in PROBLEMS[scene.problem].macros]
@@ -48,6 +50,8 @@ def macros(scene: Scene, dimension: int) -> list[str]:
     switches += axisymmetric.macros(scene, dimension)
     if scene.kinematics.updated_lagrangian:
         switches.append("-DUPDATEDLAGRANGIAN=1")     # edp/lib/kinematics.idp
+    if getattr(scene, "contact", None) is not None and scene.contact.current_configuration:
+        switches.append("-DWITHFRICTION=1")      # friction, tool, path or force control: edp/lib/friction.idp
     return switches
 
 

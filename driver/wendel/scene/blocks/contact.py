@@ -5,11 +5,18 @@ e.g. ``"+y"``); the gap is measured along that axis in the undeformed configurat
 through a registry of names to the integer ids of ``-contact_obstacle``:
 
 >>> sorted(OBSTACLES.items(), key=lambda kv: kv[1])
-[('plane', 1), ('ball', 2), ('cylinder', 3), ('heightmap', 4)]
+[('plane', 1), ('ball', 2), ('cylinder', 3), ('heightmap', 4), ('tool', 5)]
 >>> Contact(boundary="top", obstacle="ball", center=[0.0, 1.0], radius=1.0).normal
 '+y'
 >>> options(Contact(boundary="top", normal="+z", displacement=-1e-3), None, None)[:6]
 ['-contact_label', '4', '-contact_axis', '2', '-contact_dir', '1']
+
+Friction, a tool of any shape (2D polygon), a tool path or force control switch to edp/lib/friction.idp
+(current configuration, 2D and 3D) through the extra macro ``-DWITHFRICTION=1`` (wendel.loop.launch.macros):
+
+>>> c = Contact(boundary="bottom", normal="-y", friction={"law": "coulomb", "mu": 0.3})
+>>> c.current_configuration, options(c, None, None)[-10:-6]
+(True, ['-fric_law', '1', '-fric_mu', '0.3'])
 
 The scalar membrane obstacle problem (deal.II step-41, ``edp/obstacle.edp``) is the problem
 ``membrane-obstacle`` with its table ``[obstacle]``:
@@ -30,8 +37,9 @@ import shutil
 
 from . import Block, Problem, choice, register, register_problem
 from ...meshes import LABELS
+from .friction import FRICTION_LAWS, Friction, Tool, ToolPath, friction_options  # noqa: F401 (re-exported)
 
-OBSTACLES = {"plane": 1, "ball": 2, "cylinder": 3, "heightmap": 4}
+OBSTACLES = {"plane": 1, "ball": 2, "cylinder": 3, "heightmap": 4, "tool": 5}
 """Obstacle name -> ``-contact_obstacle`` id of contact.idp."""
 REFERENCES = {"hertz": 1}
 """Reference name -> ``-contact_ref`` id of contact.idp."""
@@ -60,6 +68,12 @@ class Contact(BaseModel):
     size: list[float] = Field([1.0, 1.0], description="heightmap: footprint along the two tangential axes [m]")
     c: float = Field(0.0, ge=0, description="active-set constant [Pa/m]; 0 = E / h_min (the solution does not depend on it)")
     reference: Optional[ContactReferenceName] = Field(None, description=f"reference solution: {', '.join(REFERENCES)} (contact size and peak pressure)")
+    friction: Optional[Friction] = Field(None, description="friction law (absent: frictionless)")
+    tool: Optional[Tool] = Field(None, description="obstacle = 'tool': the polygon with rounded corners (2D)")
+    path: Optional[ToolPath] = Field(None, description="the obstacle's motion along the load factor (3D: translation only)")
+    force: Optional[float] = Field(None, gt=0, description="force control: the pressing force along the normal axis at load "
+                                   "factor 1 [N; N/m in 2D]; the tool's position along that axis is solved for (displacement = first guess)")
+    force_tol: float = Field(1e-9, gt=0, lt=1e-2, description="force control: relative tolerance on the force [1]")
 
 
     @field_validator("normal")
@@ -83,9 +97,19 @@ class Contact(BaseModel):
             raise ValueError("contact.cylinder_axis must be x, y or z and differ from the normal's axis")
         if len(self.center) not in (2, 3) or len(self.size) != 2:
             raise ValueError("contact.center has 2 or 3 components, contact.size 2")
-        if self.reference == "hertz" and self.obstacle != "ball":
-            raise ValueError("contact.reference = 'hertz' needs obstacle = 'ball'")
+        if self.reference == "hertz" and self.obstacle not in ("ball", "tool"):
+            raise ValueError("contact.reference = 'hertz' needs obstacle = 'ball' or 'tool' (edge radius = contact.radius)")
+        if (self.obstacle == "tool") != (self.tool is not None):
+            raise ValueError("contact.obstacle = 'tool' and the table contact.tool go together")
+        if self.current_configuration and self.obstacle in ("cylinder", "heightmap"):
+            raise ValueError(f"contact.friction, contact.tool and contact.path work with obstacle = plane, ball or tool, "
+                             f"not {self.obstacle!r}")
         return self
+
+    @property
+    def current_configuration(self) -> bool:
+        """Friction, a tool or a path: edp/lib/friction.idp (gap and normal in the current configuration)."""
+        return self.friction is not None or self.tool is not None or self.path is not None or self.force is not None
 
     @property
     def image_path(self) -> Path:
@@ -135,11 +159,21 @@ def options(block: Contact, scene, files) -> list[str]:
             "-contact_ref", str(REFERENCES.get(block.reference, 0))]
     if block.obstacle == "heightmap":
         opts += ["-contact_image", str(block.image_path)]
+    if block.current_configuration:
+        opts += friction_options(block, files)
     return opts
 
 
-register(Block(name="contact", model=Contact, options=options, macro="WITHCONTACT",
-               fields=("contact_pressure", "contact_active", "contact_gap")))
+def _check(block: Contact, scene) -> None:
+    """Scene-level rules of friction.idp: a non-symmetric Newton matrix (no CG)."""
+    if block.current_configuration and scene.numerics.solver == "cg":
+        raise ValueError("contact.friction/tool/path/force give a non-symmetric Newton matrix: "
+                         "numerics.solver must be 'direct' or 'ffddm', not 'cg'")
+
+
+register(Block(name="contact", model=Contact, options=options, check=_check, macro="WITHCONTACT",
+               fields=("contact_pressure", "contact_active", "contact_gap", "friction_traction", "friction_slip",
+                       "friction_state")))
 
 
 MEMBRANE_SHAPES = {"staircase": 1, "radial": 2}

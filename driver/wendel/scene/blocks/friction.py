@@ -1,0 +1,119 @@
+"""The friction, tool, path and force-control keys of the ``[contact]`` block (edp/lib/friction.idp and
+edp/lib/tool.idp; contact.py composes them into its table).
+
+>>> Friction(law="tresca", tau_max=1e4).mu
+0.0
+>>> ToolPath(load_factors=[0.0, 1.0], x=[0.0, 0.1]).rows()[1]
+(1.0, 0.1, 0.0, 0.0, 0.0)
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Optional
+
+from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+from . import choice
+
+FRICTION_LAWS = {"none": 0, "coulomb": 1, "tresca": 2}
+"""Friction law name -> ``-fric_law`` id of friction.idp."""
+FrictionLawName = choice(FRICTION_LAWS, "friction law")
+
+
+class Friction(BaseModel):
+    """Friction between the body and the tool (edp/lib/friction.idp, 2D and 3D): Coulomb (optionally capped
+    in shear) or Tresca, with stick, slip and inactive sets in the same semismooth Newton as the normal contact."""
+
+    model_config = ConfigDict(extra="forbid", validate_assignment=True)
+
+    law: FrictionLawName = Field("coulomb", description=f"friction law: {', '.join(FRICTION_LAWS)}")
+    mu: float = Field(0.0, ge=0, le=10, description="Coulomb friction coefficient [1]")
+    tau_max: Optional[float] = Field(None, gt=0, description="Tresca: the slip bound; Coulomb: a cap on the shear traction [Pa]")
+    c: float = Field(0.0, ge=0, description="tangential active-set constant [Pa/m]; 0 = the normal one (contact.c)")
+    heat_fraction: float = Field(1.0, ge=0, le=1, description="share of the frictional work that heats the body (the rest the tool) [1]")
+
+    @model_validator(mode="after")
+    def _law(self):
+        if self.law == "tresca" and self.tau_max is None:
+            raise ValueError("contact.friction: law = 'tresca' needs tau_max (the slip bound, Pa)")
+        if self.law == "coulomb" and self.mu == 0 and self.tau_max is None:
+            raise ValueError("contact.friction: law = 'coulomb' needs mu > 0 (or law = 'none')")
+        return self
+
+
+class Tool(BaseModel):
+    """A rigid 2D tool: a counter-clockwise polygon at load factor 0 whose corners are rounded by radii
+    (a cutting tool: rake face, flank face and the edge radius at their corner)."""
+
+    model_config = ConfigDict(extra="forbid", validate_assignment=True)
+
+    vertices: list[list[float]] = Field(..., description="polygon vertices [[x, y], ...], counter-clockwise [m]")
+    radii: Optional[list[float]] = Field(None, description="corner radius of each vertex, 0 = sharp [m]; default all 0")
+
+    @model_validator(mode="after")
+    def _shape(self):
+        v = self.vertices
+        if len(v) < 3 or any(len(p) != 2 for p in v):
+            raise ValueError("contact.tool.vertices: at least 3 points [x, y]")
+        area = sum(v[k][0] * v[(k + 1) % len(v)][1] - v[(k + 1) % len(v)][0] * v[k][1] for k in range(len(v)))
+        if not area > 0:
+            raise ValueError("contact.tool.vertices must run counter-clockwise around a non-empty polygon")
+        if self.radii is not None and (len(self.radii) != len(v) or any(r < 0 for r in self.radii)):
+            raise ValueError("contact.tool.radii: one radius >= 0 per vertex")
+        return self
+
+
+class ToolPath(BaseModel):
+    """The tool's rigid motion as piecewise-linear functions of the load factor (extrapolated linearly past
+    the ends): translation (x, y) and rotation about contact.center; added to contact.displacement."""
+
+    model_config = ConfigDict(extra="forbid", validate_assignment=True)
+
+    load_factors: list[float] = Field(..., min_length=1, description="load factors of the path points, increasing [1]")
+    x: Optional[list[float]] = Field(None, description="translation along x at those load factors [m]; default 0")
+    y: Optional[list[float]] = Field(None, description="translation along y at those load factors [m]; default 0")
+    z: Optional[list[float]] = Field(None, description="translation along z at those load factors (3D) [m]; default 0")
+    angle: Optional[list[float]] = Field(None, description="rotation about contact.center, counter-clockwise (2D) [deg]; default 0")
+
+    @model_validator(mode="after")
+    def _lengths(self):
+        n = len(self.load_factors)
+        if any(b <= a for a, b in zip(self.load_factors, self.load_factors[1:])):
+            raise ValueError("contact.path.load_factors must increase")
+        for key in ("x", "y", "z", "angle"):
+            val = getattr(self, key)
+            if val is not None and len(val) != n:
+                raise ValueError(f"contact.path.{key} needs {n} values (one per load factor)")
+        return self
+
+    def rows(self) -> list[tuple[float, float, float, float, float]]:
+        """(load factor, x, y, z, angle in rad) per path point."""
+        n = len(self.load_factors)
+        x, y, z, a = (self.x or [0.0] * n), (self.y or [0.0] * n), (self.z or [0.0] * n), (self.angle or [0.0] * n)
+        return [(lf, xi, yi, zi, math.radians(ai)) for lf, xi, yi, zi, ai in zip(self.load_factors, x, y, z, a)]
+
+
+def friction_options(block, files) -> list[str]:
+    """The ``-fric_*``/``-tool_*`` options of friction.idp and tool.idp (its macro WITHFRICTION comes from
+    wendel.loop.launch.macros); the path and polygon tables are written into the run's tables folder (numbers only)."""
+    f = block.friction or Friction(law="none")
+    opts = ["-fric_law", str(FRICTION_LAWS[f.law]), "-fric_mu", repr(f.mu),
+            "-fric_tau", repr(f.tau_max or 0.0), "-fric_c", repr(f.c), "-fric_heat_fraction", repr(f.heat_fraction)]
+    if block.force is not None:
+        opts += ["-tool_force", repr(block.force), "-tool_force_tol", repr(block.force_tol)]
+    if files is None:
+        return opts
+    files.tables.mkdir(parents=True, exist_ok=True)
+    if block.path is not None:
+        rows = block.path.rows()
+        p = files.tables / "tool_path.txt"
+        p.write_text(f"{len(rows)}\n" + "".join(" ".join(repr(float(v)) for v in r) + "\n" for r in rows))
+        opts += ["-tool_path", str(p)]
+    if block.tool is not None:
+        v = block.tool.vertices
+        radii = block.tool.radii or [0.0] * len(v)
+        p = files.tables / "tool_polygon.txt"
+        p.write_text(f"{len(v)}\n" + "".join(f"{float(x)!r} {float(y)!r} {float(r)!r}\n" for (x, y), r in zip(v, radii)))
+        opts += ["-tool_polygon", str(p)]
+    return opts

@@ -1,0 +1,299 @@
+"""Frictional contact with a moving rigid tool (edp/lib/friction.idp, edp/lib/tool.idp): the sliding block
+(Coulomb and Tresca), the block on an incline under a horizontal pull, a polygonal punch against Hertz,
+frictional heating, bad input named."""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from wendel.loop import run
+
+from conftest import WORKFLOWS
+
+KKT = ("kkt_max_penetration", "kkt_min_pressure", "kkt_max_complementarity", "kkt_max_friction_bound",
+       "kkt_max_slip_direction", "kkt_max_friction_complementarity")
+
+
+def records(root: Path) -> list[dict]:
+    return [json.loads((d / "record.json").read_text()) for d in sorted((root / "fem").glob("inc-*"))
+            if (d / "done").is_file()]
+
+
+def variant(tmp_path: Path, name: str, replacements: dict[str, str]) -> Path:
+    text = (WORKFLOWS / f"{name}.toml").read_text()
+    for old, new in replacements.items():
+        assert old in text, old
+        text = text.replace(old, new)
+    path = tmp_path / f"{name}-variant.toml"
+    path.write_text(text)
+    return path
+
+
+def test_sliding_block_coulomb_sticks_then_slides_at_mu_n(tmp_path):
+    # Pressed (load factor 1), then dragged by the plane: full stick, partial slip from the edges, then every
+    # active node slides and the friction force is mu times the normal force, exact in the discrete sense
+    # (every node holds lambda_t = -mu lambda_n): 1e-8 relative is many digits below the first slip state.
+    root = run(WORKFLOWS / "sliding-block.toml", out=tmp_path / "sb", png=False, progress=lambda *_: None)
+    recs = records(root)
+    mu = 0.3
+    assert len(recs) == 11
+    press, first = recs[0], recs[1]
+    assert press["friction_stick_nodes"] > 0 and press["normal_force"] > 0
+    assert first["friction_stick_nodes"] > 0 and abs(first["friction_force"]) < 0.9 * mu * first["normal_force"]
+    sliding = [r for r in recs if r["friction_stick_nodes"] == 0]
+    assert len(sliding) >= 5, [r["friction_stick_nodes"] for r in recs]
+    for r in sliding:
+        assert r["friction_slip_nodes"] == r["contact_active_nodes"] > 5
+        assert abs(r["friction_force"]) == pytest.approx(mu * r["normal_force"], rel=1e-8)
+        assert r["contact_force_x"] > 0                   # the plane drags the block along +x
+    for r in recs:
+        assert all(r[k] < 1e-8 for k in KKT), {k: r[k] for k in KKT}
+        assert abs(r["friction_force"]) <= mu * r["normal_force"] * (1 + 1e-10)
+    work = [r["friction_work"] for r in recs]
+    assert all(b >= a for a, b in zip(work, work[1:])) and work[-1] > 0
+    # a sliding increment dissipates friction force x the plane's 5 mm (the block stands still)
+    assert work[-1] - work[-2] == pytest.approx(abs(recs[-1]["friction_force"]) * 0.005, rel=1e-8)
+    with open(root / "history.csv") as f:
+        hist = list(csv.DictReader(f))
+    assert {"friction_force", "normal_force", "friction_ratio", "kkt_max_friction_bound"} <= set(hist[0])
+    import meshio
+
+    mesh = meshio.read(root / "vtu" / "inc-0011.vtu")
+    assert {"friction_traction", "friction_slip", "friction_state"} <= set(mesh.point_data)
+    assert (mesh.point_data["friction_state"] == 2).sum() == recs[-1]["friction_slip_nodes"]
+
+
+def test_sliding_block_tresca_slides_at_the_bound(tmp_path):
+    tau = 3.0e4
+    scene = variant(tmp_path, "sliding-block", {
+        'friction = { law = "coulomb", mu = 0.3 }': f'friction = {{ law = "tresca", tau_max = {tau} }}'})
+    root = run(scene, out=tmp_path / "tr", png=False, progress=lambda *_: None)
+    recs = records(root)
+    assert recs[1]["friction_stick_nodes"] > 0
+    last = recs[-1]
+    assert last["friction_stick_nodes"] == 0
+    # the friction force is the bound times the contact length (lumped masses of the active nodes)
+    assert abs(last["friction_force"]) == pytest.approx(tau * last["contact_area"], rel=1e-8)
+    assert last["contact_area"] == pytest.approx(1.0, rel=1e-12)
+    assert all(r[k] < 1e-8 for r in recs for k in KKT)
+
+
+def test_sliding_block_3d_slides_along_the_drag(tmp_path):
+    # 3D: the cube pressed on a plane, then dragged along (4, 3) / 5: every node ends up sliding with
+    # |lambda_t| = mu lambda_n (node fields, 1e-8), the total friction force turns to the drag direction and its
+    # ratio to the normal force tends to mu as the slip directions align (the 3D slip direction is solved by
+    # the semismooth Newton step of Hueber-Stadler-Wohlmuth, not frozen).
+    from wendel.results import vtu as output
+
+    root = run(WORKFLOWS / "sliding-block-3d.toml", smoke=True, out=tmp_path / "s3", png=False, progress=lambda *_: None)
+    recs = records(root)
+    assert len(recs) == 11 and recs[1]["friction_stick_nodes"] > 0 and recs[-1]["friction_stick_nodes"] == 0
+    for r in recs:
+        assert all(r[k] < 1e-8 for k in KKT), {k: r[k] for k in KKT}
+        assert r["newton_iterations"] <= 10
+    last = recs[-1]
+    assert last["friction_ratio"] == pytest.approx(0.3, rel=1e-6)
+    assert last["contact_force_x"] / last["contact_force_y"] == pytest.approx(4 / 3, rel=1e-3)
+    d = root / "fem" / "inc-0011"
+    p = output.read_array(d / "contact_pressure.node.txt")
+    t = output.read_array(d / "friction_traction.node.txt")
+    active = output.read_array(d / "contact_active.node.txt") > 0.5
+    assert active.sum() == last["contact_active_nodes"] > 10
+    assert np.abs(t[active] - 0.3 * p[active]).max() <= 1e-8 * p[active].max()
+
+
+def test_force_control_in_3d_presses_and_drags_at_the_target_force(tmp_path):
+    # The 3D block pressed by the plane with lf x 2e5 N (its height solved for), dragged from load factor 1 on:
+    # the pressing force meets the target in every increment and the drag slides at about mu times it (the
+    # slip directions of the nodes are not yet aligned: the vector sum is 0.1% below mu N here).
+    scene = variant(tmp_path, "sliding-block-3d", {
+        "z = [0.0, 0.01, 0.01] }": "z = [0.0, 0.0, 0.0] }",
+        'center = [0.0, 0.0, 0.0] # m': 'force = 2.0e5\ndisplacement = 0.005\ncenter = [0.0, 0.0, 0.0] # m'})
+    root = run(scene, smoke=True, out=tmp_path / "f3", png=False, progress=lambda *_: None)
+    recs = records(root)
+    for r in recs:
+        assert r["pressing_force"] == pytest.approx(2.0e5 * r["load_factor"], rel=1e-8) and r["error_force"] < 1e-8
+        assert all(r[k] < 1e-8 for k in KKT)
+    assert recs[-1]["friction_stick_nodes"] == 0 and recs[-1]["friction_ratio"] == pytest.approx(0.3, rel=2e-3)
+    assert recs[-1]["tool_z"] > 0.005                             # m: the plane rose to carry the load
+
+
+def test_one_and_two_ranks_agree(tmp_path):
+    # Every rank holds the whole frictional system (its sets are the same on every rank); ffddm's GMRES
+    # solves the non-symmetric Newton matrix on 2 ranks.
+    recs = {}
+    for np in (1, 2):
+        root = run(WORKFLOWS / "sliding-block.toml", smoke=True, ranks=np, out=tmp_path / f"np{np}", png=False,
+                   progress=lambda *_: None)
+        recs[np] = records(root)
+    assert recs[2][-1]["ranks"] == 2 and recs[2][-1]["solver"] == "ffddm"
+    assert [r["newton_iterations"] for r in recs[1]] == [r["newton_iterations"] for r in recs[2]]
+    for a, b in zip(recs[1], recs[2]):
+        assert b["friction_force"] == pytest.approx(a["friction_force"], rel=1e-8)
+        assert b["normal_force"] == pytest.approx(a["normal_force"], rel=1e-8)
+        assert b["friction_stick_nodes"] == a["friction_stick_nodes"]
+
+
+def test_incline_pull_at_which_sliding_starts(tmp_path):
+    # A block on a 10 deg incline under gravity (rho g = 1e5 N/m^3 times the load factor), its top held by a
+    # frictionless horizontal guide; from load factor 1 on the incline slides down the slope. The guide's
+    # horizontal pull R (= -contact force x by equilibrium) grows while the block sticks and reaches
+    # W tan(alpha + atan(mu)) when every node slides (closed form of the rigid block: 1e-8 relative).
+    root = run(WORKFLOWS / "incline.toml", out=tmp_path / "inc", png=False, progress=lambda *_: None)
+    recs = records(root)
+    alpha, mu = math.radians(10.0), 0.3
+    closed = math.tan(alpha + math.atan(mu))
+    ratios = []
+    for r in recs:
+        weight = r["load_factor"] * 1.0e5 * 0.5            # N/m: rho g times the block's area 1 m x 0.5 m
+        assert r["contact_force_y"] == pytest.approx(weight, rel=1e-9)
+        ratios.append(-r["contact_force_x"] / weight)
+        assert all(r[k] < 1e-8 for k in KKT), {k: r[k] for k in KKT}
+    stick = [q for q, r in zip(ratios, recs) if r["friction_stick_nodes"] > 0]
+    slide = [q for q, r in zip(ratios, recs) if r["friction_stick_nodes"] == 0]
+    assert stick and len(slide) >= 5
+    assert all(q < closed * (1 - 1e-3) for q in stick), (stick, closed)
+    assert all(q == pytest.approx(closed, rel=1e-8) for q in slide), (slide, closed)
+
+
+def test_punch_with_an_edge_radius_matches_hertz(tmp_path):
+    # The wedge's rounded tip (R = 1 m) against the block of the Hertz scene, gap and normal from the tool's
+    # signed distance in the current configuration: the tolerances of the ball's Hertz test (5%; measured
+    # 1.1% contact half-width, 0.2% peak pressure; the ball: 1.6% and 0.7%).
+    root = run(WORKFLOWS / "punch.toml", out=tmp_path / "punch", png=False, progress=lambda *_: None)
+    last = json.loads((root / "summary.json").read_text())["last_increment"]
+    assert last["error_contact_size"] < 0.05 and last["error_max_pressure"] < 0.05
+    assert all(last[k] < 1e-8 for k in KKT), {k: last[k] for k in KKT}
+    assert last["contact_active_nodes"] > 10
+    assert abs(last["contact_min_gap_undeformed"]) < 1e-12      # the tip touches the block at load factor 0
+
+
+def test_hertz_at_a_prescribed_force_in_one_run(tmp_path):
+    # Force control: the cylinder's position is a Newton unknown (bordered system: the step at a fixed tool
+    # and the response to a unit tool motion); one run reaches 1e7 N/m, and the contact size is within the
+    # Hertz test's 5% (measured 0.24% half-width, 0.18% peak pressure).
+    root = run(WORKFLOWS / "hertz-force.toml", out=tmp_path / "hf", png=False, progress=lambda *_: None)
+    s = json.loads((root / "summary.json").read_text())
+    last = s["last_increment"]
+    assert s["increments"] == 1 and s["step_cuts"] == 0
+    assert last["pressing_force"] == pytest.approx(1.0e7, rel=1e-8) and last["error_force"] < 1e-8
+    assert last["error_contact_size"] < 0.05 and last["error_max_pressure"] < 0.05
+    assert all(last[k] < 1e-8 for k in KKT)
+    assert -0.03 < last["tool_position"] < -0.01                    # moved from its first guess (-0.01 m)
+    with open(root / "history.csv") as f:
+        assert {"tool_position", "pressing_force", "force_target"} <= set(next(csv.DictReader(f)))
+
+
+def test_scratch_large_sliding_of_a_rounded_wedge(tmp_path):
+    # The wedge (edge radius 0.5 m) pressed 10 mm into an elastic-plastic block, then dragged 0.4 m, eight
+    # contact widths: the contact follows the tool (gap and normal recomputed in the current configuration
+    # every Newton iteration), every active node slides at lambda_t = -mu lambda_n, the groove yields.
+    root = run(WORKFLOWS / "scratch.toml", smoke=True, out=tmp_path / "scr", png=False, progress=lambda *_: None)
+    recs = records(root)
+    assert [r["load_factor"] for r in recs] == pytest.approx([0.25 * k for k in range(1, 9)])
+    for r in recs:
+        assert all(r[k] < 1e-8 for k in KKT), {k: r[k] for k in KKT}
+        assert r["contact_active_nodes"] >= 5
+    for r in recs[4:]:
+        assert r["friction_stick_nodes"] == 0
+        assert abs(r["friction_force"]) == pytest.approx(0.2 * r["normal_force"], rel=1e-8)
+    assert recs[-1]["tool_x"] == pytest.approx(0.4)
+    assert recs[-1]["plastic_points"] > 50
+    from wendel.results import vtu as output
+
+    pts = output.read_vertices(root / "fem" / "vertices.txt")
+    active = output.read_array(root / "fem" / "inc-0008" / "contact_active.node.txt") > 0.5
+    centre = pts[active, 0].mean()
+    assert centre == pytest.approx(0.4, abs=0.03)          # m: the contact zone moved with the tool
+
+
+def test_frictional_heat_enters_the_body_by_its_fraction(tmp_path):
+    # The sliding block with an insulated heat equation: the contact heat that entered the body equals
+    # heat_fraction x frictional work, and the heat stored in the block (rho c int dT) equals it: 1e-6.
+    root = run(WORKFLOWS / "sliding-heat.toml", out=tmp_path / "sh", png=False, progress=lambda *_: None)
+    last = json.loads((root / "summary.json").read_text())["last_increment"]
+    work = last["friction_work"]
+    assert work > 1000                                        # J/m: about 0.3 x 2.4e5 N/m x 40 mm of slip
+    assert last["heat_contact"] == pytest.approx(0.5 * work, rel=1e-6)
+    assert last["friction_heat_tool"] == pytest.approx(0.5 * work, rel=1e-12)
+    assert last["thermal_energy_change"] == pytest.approx(0.5 * work, rel=1e-6)
+    assert last["energy_balance_error"] < 1e-6
+    assert last["max_temperature"] > 293.15 + 0.05             # K: the contact face warms up
+    assert all(last[k] < 1e-8 for k in KKT)
+
+
+def test_capped_coulomb_slides_at_min_of_mu_p_and_the_cap(tmp_path):
+    # Coulomb with a cap on the shear traction (cutting models): sliding nodes carry min(mu p, tau_max).
+    from wendel.results import vtu as output
+
+    tau, mu = 6.0e4, 0.3
+    scene = variant(tmp_path, "sliding-block", {
+        'friction = { law = "coulomb", mu = 0.3 }': f'friction = {{ law = "coulomb", mu = {mu}, tau_max = {tau} }}'})
+    root = run(scene, out=tmp_path / "cap", png=False, progress=lambda *_: None)
+    recs = records(root)
+    assert recs[-1]["friction_stick_nodes"] == 0 and all(r[k] < 1e-8 for r in recs for k in KKT)
+    d = root / "fem" / "inc-0011"
+    p = output.read_array(d / "contact_pressure.node.txt")
+    t = output.read_array(d / "friction_traction.node.txt")
+    active = output.read_array(d / "contact_active.node.txt") > 0.5
+    bound = np.minimum(mu * p[active], tau)
+    assert np.abs(np.abs(t[active]) - bound).max() <= 1e-8 * tau
+    assert (mu * p[active] > tau).sum() >= 3 and (mu * p[active] < tau).sum() >= 3    # both branches present
+
+
+def test_restarts_between_increments_keep_the_friction_state(tmp_path):
+    # loading.adaptive launches FreeFEM once per increment from the last checkpoint (-restart): the sets, the
+    # load factor and tool position of the last increment and the frictional work come back from its folder.
+    factors = "factors = [" + ", ".join(f"{0.1 * k:.1f}" for k in range(1, 21)) + "]"
+    old = "factors = [1.0, 1.1, 1.2, 1.3, 1.4, 1.5, 1.6, 1.7, 1.8, 1.9, 2.0]"
+    runs = {}
+    for name, head in (("one", "[loading]\n"), ("many", "[loading]\nadaptive = true\n")):
+        (tmp_path / name).mkdir()
+        scene = variant(tmp_path / name, "sliding-block", {old: factors, "[loading]\n": head})
+        runs[name] = records(run(scene, smoke=True, out=tmp_path / name / "run", png=False, progress=lambda *_: None))
+    a, b = runs["one"][-1], runs["many"][-1]
+    assert len(runs["many"]) == len(runs["one"]) == 20
+    for key in ("friction_force", "normal_force", "friction_work"):
+        assert b[key] == pytest.approx(a[key], rel=1e-10), key
+
+
+def test_bad_friction_input_is_named(tmp_path):
+    from wendel.scene import load
+
+    scene = variant(tmp_path, "sliding-block", {'law = "coulomb", mu = 0.3': 'law = "tresca", mu = 0.3'})
+    with pytest.raises(Exception, match="tau_max"):
+        load(scene)
+    scene = variant(tmp_path, "sliding-block", {'law = "coulomb"': 'law = "amontons"'})
+    with pytest.raises(Exception, match="coulomb"):
+        load(scene)
+    scene = variant(tmp_path, "sliding-block", {'solver = "direct"': 'solver = "cg"'})
+    with pytest.raises(Exception, match="numerics.solver"):
+        load(scene)
+    scene = variant(tmp_path, "punch", {"radii = [1.0, 0.0, 0.0]": "radii = [1.0, -1.0, 0.0]"})
+    with pytest.raises(Exception, match="radii"):
+        load(scene)
+    # the command line names the file and the key, exit code 2, no traceback
+    import subprocess
+    import sys
+
+    proc = subprocess.run([sys.executable, "-m", "wendel.cli", "check", str(scene)], capture_output=True, text=True)
+    assert proc.returncode == 2 and "radii" in proc.stderr + proc.stdout and "Traceback" not in proc.stderr
+
+
+def test_friction_bench_at_smoke_sizes(tmp_path):
+    from wendel.bench import BENCHES, bench
+
+    root = bench(["friction"], quick=True, out=tmp_path / "bench", progress=lambda *_: None)
+    assert "friction" in BENCHES
+    rows = json.loads((root / "friction.json").read_text())["rows"]
+    assert len(rows) == 6 and all(r["newton_iterations"] >= r["increments"] for r in rows)
+    by = {(r["scene"], r["variant"].split(" (")[0]): r for r in rows}
+    assert by[("sliding-block", "Coulomb mu = 0.3")]["friction_ratio"] == pytest.approx(0.3, rel=1e-8)
+    # friction costs Newton iterations, but not many more than the frictionless solve (measured 1.5x on Hertz)
+    assert by[("hertz", "Coulomb mu = 0.3")]["iterations_vs_frictionless"] <= 2.0
