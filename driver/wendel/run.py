@@ -13,7 +13,7 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from . import freefem, output, remeshing, report
+from . import freefem, output, petsc, remeshing, report
 from .blocks import BLOCKS, PROBLEMS
 from .meshes import LABELS, build as build_mesh
 from .schema import ANALYTIC_REFERENCES, BODY_FORCES, Scene
@@ -340,6 +340,8 @@ def options(scene: Scene, files: RunFiles, dimension: int, segment: dict | None 
     segment = segment or {"mesh": "mesh.msh", "ubase": None, "eps0": None}
     opts = ["-mesh", str(files.root / segment["mesh"]), "-solver", n.solver, "-solver_tol", repr(n.solver_tol),
             "-newton_tol", repr(n.newton_tol), "-newton_maxit", str(n.newton_maxit)]
+    if n.solver == "petsc":
+        opts += petsc.launch_options(n.petsc.pc, n.petsc.options, n.petsc.reuse)
     if scene.problem != "mechanics":
         return opts + PROBLEMS[scene.problem].options(scene, files, dimension)
     m = scene.material

@@ -18,11 +18,12 @@ from pydantic import BaseModel, ConfigDict, Field, create_model, field_validator
 from .blocks import BLOCKS, PROBLEMS, choice, load_all
 from .comparisons import COMPARISONS
 from .meshes import BUILDERS
+from .petsc import PRECONDITIONERS, PcName, check_options
 
 # Names a scene may use, mapped to the integer ids of edp/lib/loads.idp (never code).
 BODY_FORCES = {"none": 0, "constant": 1, "step8-discs": 2, "manufactured": 3}
 ANALYTIC_REFERENCES = {"manufactured-sine": 1}
-SOLVERS = ("direct", "cg", "ffddm")
+SOLVERS = ("direct", "cg", "ffddm", "petsc")
 
 BodyForceName = choice(BODY_FORCES, "body force")
 SolverName = choice(SOLVERS, "solver")
@@ -133,6 +134,21 @@ class Loading(Strict):
         return min(abs(b - a) for a, b in zip([0.0] + t[:-1], t)) or 1.0
 
 
+class Petsc(Strict):
+    """The PETSc solver (numerics.solver = "petsc"): CG + a preconditioner preset, PETSc options on top."""
+
+    pc: PcName = Field("gamg", description=f"preconditioner: {', '.join(PRECONDITIONERS)}")
+    options: str = Field("", description="more PETSc options, \"-name value\" pairs (e.g. \"-ksp_rtol 1e-8\"); "
+                         "they override the preset; no option that reads or writes files")
+    reuse: bool = Field(True, description="keep the preconditioner across Newton steps and increments while "
+                        "the iterations stay below 1.5x those right after its setup")
+
+    @field_validator("options")
+    @classmethod
+    def _options(cls, v):
+        return check_options(v)
+
+
 class Numerics(Strict):
     """Solver settings."""
 
@@ -142,6 +158,7 @@ class Numerics(Strict):
     newton_tol: float = Field(1e-9, gt=0, lt=1, description="relative Newton residual [1]")
     newton_maxit: int = Field(25, ge=1, le=500, description="Newton iterations per increment")
     timeout: float = Field(3600.0, gt=0, description="wall-time limit of one FreeFEM launch [s]")
+    petsc: Petsc = Field(default_factory=Petsc, description="PETSc solver settings (solver = \"petsc\")")
 
 
     @model_validator(mode="after")
