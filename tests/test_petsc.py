@@ -1,6 +1,6 @@
 """The PETSc solver path (edp/plugins/wendel_petsc.cpp through lib/petsc.idp): the same Newton iterates as the
-direct solver on step-42's ball (contact + plasticity) for every preconditioner preset, Dirichlet values
-entering the first Newton step, and a bad options string refused with its key named."""
+direct solver on step-42's ball (contact + plasticity) for every preconditioner preset and on 2 ranks, Dirichlet
+values entering the first Newton step, and a bad options string refused with its key named."""
 
 from __future__ import annotations
 
@@ -16,10 +16,11 @@ from wendel.scene import load
 from conftest import WORKFLOWS
 
 
-def solve(name: str, solver: str, out, pc: str = "gamg", options: str = "") -> dict:
+def solve(name: str, solver: str, out, pc: str = "gamg", options: str = "", ranks: int = 1) -> dict:
     path = WORKFLOWS / f"{name}.toml"
     scene = load(path, smoke=True)
     scene.numerics.solver = solver
+    scene.numerics.ranks = ranks
     scene.numerics.petsc.pc = pc
     scene.numerics.petsc.options = options
     scene.output.png = False
@@ -46,6 +47,16 @@ def test_petsc_agrees_with_direct_on_contact_plasticity(tmp_path, ball_direct, p
     assert lp["contact_active_nodes"] == ld["contact_active_nodes"] > 0
     # AMG: a few Krylov iterations per Newton step, not one (direct) and not hundreds (Jacobi)
     assert 2 * lp["newton_iterations"] < lp["linear_iterations"] < 60 * lp["newton_iterations"]
+
+
+def test_petsc_two_ranks(tmp_path, ball_direct):
+    """Two ranks: each builds its block of rows of the distributed matrix; the same iterates."""
+    p = solve("ball-indent", "petsc", tmp_path / "np2", ranks=2)
+    ld, lp = ball_direct["last_increment"], p["last_increment"]
+    assert lp["ranks"] == 2
+    assert lp["contact_force"] == pytest.approx(ld["contact_force"], rel=1e-7)
+    assert lp["max_displacement"] == pytest.approx(ld["max_displacement"], rel=1e-7)
+    assert p["newton_iterations"] == ball_direct["newton_iterations"]
 
 
 def test_petsc_prescribed_displacement(tmp_path):

@@ -9,7 +9,7 @@ in ``-name value`` pairs of a safe character set, and no option may read or writ
 >>> check_options("-ksp_type cg;reboot")
 Traceback (most recent call last):
 ...
-ValueError: value 'cg;reboot' of -ksp_type: only letters, digits and _ . + - are allowed
+ValueError: value 'cg;reboot' of -ksp_type: only letters, digits and _ . + , - are allowed
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ PRECONDITIONERS = {"gamg": "smoothed-aggregation AMG with the rigid-body modes",
 PcName = choice(PRECONDITIONERS, "preconditioner")
 
 _NAME = re.compile(r"-[A-Za-z][A-Za-z0-9_]*")
-_VALUE = re.compile(r"-?[A-Za-z0-9_.+][A-Za-z0-9_.+-]*")
+_VALUE = re.compile(r"-?[A-Za-z0-9_.+][A-Za-z0-9_.+,-]*")
 # Options that read or write files (viewers, logs, option files) are refused.
 _FILE_WORDS = ("options_file", "view", "log", "history", "dump", "draw", "save", "load")
 
@@ -42,7 +42,7 @@ def check_options(text: str) -> str:
         if any(w in name.lower() for w in _FILE_WORDS):
             raise ValueError(f"{name}: options that read or write files are not allowed")
         if not _VALUE.fullmatch(value):
-            raise ValueError(f"value {value!r} of {name}: only letters, digits and _ . + - are allowed")
+            raise ValueError(f"value {value!r} of {name}: only letters, digits and _ . + , - are allowed")
     return text
 
 

@@ -163,8 +163,9 @@ class Numerics(Strict):
 
     @model_validator(mode="after")
     def _ranks(self):
-        if self.ranks > 1 and self.solver != "ffddm":
-            raise ValueError(f"solver {self.solver!r} runs on one rank; use solver = \"ffddm\" with ranks = {self.ranks}")
+        if self.ranks > 1 and self.solver not in ("ffddm", "petsc"):
+            raise ValueError(f"solver {self.solver!r} runs on one rank; use solver = \"ffddm\" or \"petsc\" "
+                             f"with ranks = {self.ranks}")
         return self
 
 

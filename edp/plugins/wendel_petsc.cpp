@@ -9,8 +9,9 @@
 //   b        right-hand side, read only: the rows with fix = 1 hold their prescribed values (already lifted
 //            into the free rows by the caller, lib/solver.idp).
 //   x        output, resized to K.n: the solution.
-//   fix      size K.n (1 = fixed row) or 0: fixed rows and columns become identity rows and columns
-//            (entries kept as explicit zeros, so the sparsity pattern stays that of K).
+//   fix      size K.n (1 = fixed row) or 0: fixed rows and columns become identity rows and columns, scaled
+//            by the mean diagonal of the free rows (and their b with them); the entries stay as explicit
+//            zeros, so the sparsity pattern stays that of K.
 //   coords   size K.n, node coordinates interleaved per node (x0 y0 [z0] x1 ...), or size 0: with bs > 1 the
 //            rigid-body modes built from them are the near null space of GAMG and ML.
 //   bs       block size (the space dimension for a displacement field, 1 for a scalar field).
@@ -19,9 +20,12 @@
 //            matrix with the same pattern, rebuilt when a solve needs more than 1.5x the iterations of the
 //            solve right after its setup, or fails.
 //   info     output, resized to 6: iterations, true relative residual ||b - A x|| / ||b||, KSP converged
-//            reason (> 0 converged), 1 if the preconditioner was reused, seconds in CSR + setup, seconds in
-//            the Krylov solve.
+//            reason (> 0 converged), 1 if the preconditioner was reused, seconds in CSR + setup, seconds
+//            in the Krylov solve.
 //   returns  the iterations; a PETSc error or a solve that does not converge stops the script (ExecError).
+//
+// On N MPI ranks (FreeFem++-mpi) every rank passes the same whole system; each rank builds its block of
+// rows (whole nodes) of an MPIAIJ matrix, the solve runs on all ranks, and every rank gets the whole x.
 //
 // State kept between calls: one cached solver (Mat, KSP, CSR pattern and the permutation from K's triplets
 // to it) under the key (n, nnz, bs, checksum of the triplet indices, options string). A call with another
@@ -48,9 +52,13 @@ struct Cache {
     // solver
     Mat A = nullptr;
     KSP ksp = nullptr;
-    Vec b = nullptr, x = nullptr, r = nullptr;
+    Vec b = nullptr, x = nullptr, r = nullptr, xAll = nullptr;
+    VecScatter toAll = nullptr;                // the distributed solution to every rank (2+ ranks)
     std::vector<PetscInt> rowptr, col, diag;   // CSR of K; diag[i] = position of (i, i)
     std::vector<PetscInt> perm;                // triplet k of K -> CSR position
+    std::vector<PetscScalar> val;              // values in CSR order
+    PetscInt rstart = 0, rend = 0;             // this rank's rows (whole nodes: multiples of bs)
+    PetscMPIInt size = 1;
     bool reuse = true;
     PetscInt itsAtSetup = 0;
     bool stale = true;                         // rebuild the preconditioner at the next solve
@@ -66,6 +74,8 @@ PetscErrorCode destroyCache()
     PetscCall(VecDestroy(&cache.b));
     PetscCall(VecDestroy(&cache.x));
     PetscCall(VecDestroy(&cache.r));
+    PetscCall(VecDestroy(&cache.xAll));
+    PetscCall(VecScatterDestroy(&cache.toAll));
     cache = Cache();
     PetscFunctionReturn(0);
 }
@@ -130,27 +140,50 @@ PetscErrorCode buildPattern(const HashMatrix<int, double>& H)
     PetscFunctionReturn(0);
 }
 
-// The values of K with fixed rows and columns turned into identity rows and columns.
-PetscErrorCode fillValues(const HashMatrix<int, double>& H, const KN<double>& fix)
+// The values of K with fixed rows and columns turned into identity rows and columns scaled by the mean
+// diagonal of the free rows (a unit diagonal next to stiffness entries of 1e3-1e11 upsets the AMG
+// smoothers). One rank: written straight into the matrix; 2+ ranks: each rank sets its own rows.
+PetscErrorCode fillValues(const HashMatrix<int, double>& H, const KN<double>& fix, double* scale)
 {
     PetscFunctionBeginUser;
     const long n = H.n, nnz = (long)H.nnz, f = H.fortran;
     const bool masked = fix.N() == n;
-    PetscScalar* v;
-    PetscCall(MatSeqAIJGetArray(cache.A, &v));
+    std::vector<PetscScalar>& v = cache.val;
+    v.resize(nnz);
     for (long k = 0; k < nnz; ++k) {
         double a = H.aij[k];
         if (masked && (fix[H.i[k] - f] > 0.5 || fix[H.j[k] - f] > 0.5)) a = 0.;
         v[cache.perm[k]] = a;
     }
-    if (masked)
+    *scale = 1.;
+    if (masked) {
+        double sum = 0;
+        long nFree = 0;
+        for (long i = 0; i < n; ++i)
+            if (fix[i] <= 0.5 && cache.diag[i] >= 0) {
+                sum += std::fabs(v[cache.diag[i]]);
+                ++nFree;
+            }
+        if (nFree > 0 && sum > 0) *scale = sum / nFree;
         for (long i = 0; i < n; ++i)
             if (fix[i] > 0.5) {
                 PetscCheck(cache.diag[i] >= 0, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG,
                            "fixed row %ld has no diagonal entry in the matrix", i);
-                v[cache.diag[i]] = 1.;
+                v[cache.diag[i]] = *scale;
             }
-    PetscCall(MatSeqAIJRestoreArray(cache.A, &v));
+    }
+    if (cache.size == 1) {
+        PetscScalar* a;
+        PetscCall(MatSeqAIJGetArray(cache.A, &a));
+        std::copy(v.begin(), v.end(), a);
+        PetscCall(MatSeqAIJRestoreArray(cache.A, &a));
+    }
+    else
+        for (PetscInt i = cache.rstart; i < cache.rend; ++i) {
+            PetscInt p = cache.rowptr[i];
+            PetscCall(MatSetValues(cache.A, 1, &i, cache.rowptr[i + 1] - p, cache.col.data() + p, v.data() + p,
+                                   INSERT_VALUES));
+        }
     PetscCall(MatAssemblyBegin(cache.A, MAT_FINAL_ASSEMBLY));
     PetscCall(MatAssemblyEnd(cache.A, MAT_FINAL_ASSEMBLY));
     PetscFunctionReturn(0);
@@ -159,22 +192,38 @@ PetscErrorCode fillValues(const HashMatrix<int, double>& H, const KN<double>& fi
 PetscErrorCode setupSolver(const KN<double>& coords, long bs)
 {
     PetscFunctionBeginUser;
-    const PetscInt n = (PetscInt)cache.n;
-    std::vector<PetscScalar> zero(cache.nnz, 0.);
-    PetscCall(MatCreate(PETSC_COMM_SELF, &cache.A));
-    PetscCall(MatSetSizes(cache.A, n, n, n, n));
-    PetscCall(MatSetType(cache.A, MATSEQAIJ));
+    const PetscInt n = (PetscInt)cache.n, nb = n / (PetscInt)bs;
+    PetscMPIInt rank;
+    PetscCallMPI(MPI_Comm_size(PETSC_COMM_WORLD, &cache.size));
+    PetscCallMPI(MPI_Comm_rank(PETSC_COMM_WORLD, &rank));
+    MPI_Comm comm = cache.size == 1 ? PETSC_COMM_SELF : PETSC_COMM_WORLD;
+    cache.rstart = (PetscInt)bs * (PetscInt)((long)nb * rank / cache.size);
+    cache.rend = (PetscInt)bs * (PetscInt)((long)nb * (rank + 1) / cache.size);
+    const PetscInt nloc = cache.rend - cache.rstart;
+    PetscCall(MatCreate(comm, &cache.A));
+    PetscCall(MatSetSizes(cache.A, nloc, nloc, n, n));
+    PetscCall(MatSetType(cache.A, cache.size == 1 ? MATSEQAIJ : MATMPIAIJ));
     PetscCall(MatSetBlockSize(cache.A, (PetscInt)bs));
-    PetscCall(MatSeqAIJSetPreallocationCSR(cache.A, cache.rowptr.data(), cache.col.data(), zero.data()));
+    std::vector<PetscScalar> zero(cache.nnz, 0.);
+    if (cache.size == 1)
+        PetscCall(MatSeqAIJSetPreallocationCSR(cache.A, cache.rowptr.data(), cache.col.data(), zero.data()));
+    else {
+        std::vector<PetscInt> ia(nloc + 1);
+        for (PetscInt i = 0; i <= nloc; ++i) ia[i] = cache.rowptr[cache.rstart + i] - cache.rowptr[cache.rstart];
+        PetscInt p0 = cache.rowptr[cache.rstart];
+        PetscCall(MatMPIAIJSetPreallocationCSR(cache.A, ia.data(), cache.col.data() + p0, zero.data() + p0));
+    }
     PetscCall(MatSetOption(cache.A, MAT_NEW_NONZERO_LOCATION_ERR, PETSC_TRUE));
     if (bs > 1 && coords.N() == n) {
         Vec c;
         MatNullSpace ns;
-        PetscCall(VecCreateSeq(PETSC_COMM_SELF, n, &c));
+        PetscCall(VecCreate(comm, &c));
+        PetscCall(VecSetSizes(c, nloc, n));
         PetscCall(VecSetBlockSize(c, (PetscInt)bs));
+        PetscCall(VecSetType(c, VECSTANDARD));
         PetscScalar* pc;
         PetscCall(VecGetArray(c, &pc));
-        for (PetscInt i = 0; i < n; ++i) pc[i] = coords[i];
+        for (PetscInt i = 0; i < nloc; ++i) pc[i] = coords[cache.rstart + i];
         PetscCall(VecRestoreArray(c, &pc));
         PetscCall(MatNullSpaceCreateRigidBody(c, &ns));
         PetscCall(MatSetNearNullSpace(cache.A, ns));
@@ -183,7 +232,8 @@ PetscErrorCode setupSolver(const KN<double>& coords, long bs)
     }
     PetscCall(MatCreateVecs(cache.A, &cache.x, &cache.b));
     PetscCall(VecDuplicate(cache.b, &cache.r));
-    PetscCall(KSPCreate(PETSC_COMM_SELF, &cache.ksp));
+    if (cache.size > 1) PetscCall(VecScatterCreateToAll(cache.x, &cache.toAll, &cache.xAll));
+    PetscCall(KSPCreate(comm, &cache.ksp));
     PetscCall(KSPSetOperators(cache.ksp, cache.A, cache.A));
     PetscCall(KSPSetFromOptions(cache.ksp));
     PetscBool reuse = PETSC_TRUE, set = PETSC_FALSE;
@@ -192,7 +242,7 @@ PetscErrorCode setupSolver(const KN<double>& coords, long bs)
     PetscFunctionReturn(0);
 }
 
-double seconds()
+double seconds()                               // wall time, like the phase times of lib/mechanics.idp
 {
     using namespace std::chrono;
     return duration<double>(steady_clock::now().time_since_epoch()).count();
@@ -228,10 +278,12 @@ PetscErrorCode solve(Matrice_Creuse<double>* K, KN<double>* b, KN<double>* x, KN
         PetscCall(buildPattern(*H));
         PetscCall(setupSolver(*coords, bs));
     }
-    PetscCall(fillValues(*H, *fix));
+    double scale = 1.;
+    PetscCall(fillValues(*H, *fix, &scale));
     PetscScalar* pb;
     PetscCall(VecGetArray(cache.b, &pb));
-    for (long i = 0; i < n; ++i) pb[i] = (*b)[i];
+    for (long i = cache.rstart; i < cache.rend; ++i)
+        pb[i - cache.rstart] = (fix->N() == n && (*fix)[i] > 0.5) ? scale * (*b)[i] : (*b)[i];
     PetscCall(VecRestoreArray(cache.b, &pb));
 
     bool reused = false;
@@ -271,10 +323,16 @@ PetscErrorCode solve(Matrice_Creuse<double>* K, KN<double>* b, KN<double>* x, KN
     PetscCall(VecNorm(cache.r, NORM_2, &rn));
     PetscCall(VecNorm(cache.b, NORM_2, &bn));
     x->resize(n);
+    Vec xs = cache.x;
+    if (cache.size > 1) {
+        PetscCall(VecScatterBegin(cache.toAll, cache.x, cache.xAll, INSERT_VALUES, SCATTER_FORWARD));
+        PetscCall(VecScatterEnd(cache.toAll, cache.x, cache.xAll, INSERT_VALUES, SCATTER_FORWARD));
+        xs = cache.xAll;
+    }
     const PetscScalar* px;
-    PetscCall(VecGetArrayRead(cache.x, &px));
+    PetscCall(VecGetArrayRead(xs, &px));
     for (long i = 0; i < n; ++i) (*x)[i] = px[i];
-    PetscCall(VecRestoreArrayRead(cache.x, &px));
+    PetscCall(VecRestoreArrayRead(xs, &px));
     info->resize(6);
     (*info)[0] = its;
     (*info)[1] = bn > 0 ? rn / bn : rn;
@@ -282,6 +340,7 @@ PetscErrorCode solve(Matrice_Creuse<double>* K, KN<double>* b, KN<double>* x, KN
     (*info)[3] = reused ? 1 : 0;
     (*info)[4] = seconds() - t0 - tSolve;
     (*info)[5] = tSolve;
+    fflush(stdout);                            // monitors and views asked for in the options: before FreeFEM exits
     PetscFunctionReturn(0);
 }
 
