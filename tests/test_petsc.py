@@ -16,7 +16,7 @@ from wendel.scene import load
 from conftest import WORKFLOWS
 
 
-def solve(name: str, solver: str, out, pc: str = "gamg", options: str = "", ranks: int = 1) -> dict:
+def solve(name: str, solver: str, out, pc: str = "ml", options: str = "", ranks: int = 1) -> dict:
     path = WORKFLOWS / f"{name}.toml"
     scene = load(path, smoke=True)
     scene.numerics.solver = solver
@@ -74,6 +74,7 @@ def test_petsc_prescribed_displacement(tmp_path):
     ("-ksp_rtol", "pairs"),
     ("-ksp_view_mat binary", "read or write files"),
     ("-options_file x", "read or write files"),
+    ("-start_in_debugger gdb", "start programs"),
     ("ksp_rtol 1e-8", "not an option name"),
 ])
 def test_bad_petsc_options_refused(tmp_path, options, why):

@@ -19,16 +19,17 @@ import re
 from .blocks import choice
 
 # Presets of edp/lib/petsc.idp (CG on the masked, symmetric Newton matrix, block size = dimension).
-PRECONDITIONERS = {"gamg": "smoothed-aggregation AMG with the rigid-body modes",
+PRECONDITIONERS = {"ml": "Trilinos ML with the rigid-body modes, its own Richardson + SSOR smoothing (default)",
+                   "gamg": "PETSc's smoothed-aggregation AMG with the rigid-body modes, Chebyshev smoothing",
                    "hypre": "BoomerAMG (HMIS, ext+i, Chebyshev smoothing)",
-                   "ml": "Trilinos ML with the rigid-body modes, Chebyshev smoothing",
                    "jacobi": "point Jacobi (for comparisons)"}
 PcName = choice(PRECONDITIONERS, "preconditioner")
 
 _NAME = re.compile(r"-[A-Za-z][A-Za-z0-9_]*")
 _VALUE = re.compile(r"-?[A-Za-z0-9_.+][A-Za-z0-9_.+,-]*")
-# Options that read or write files (viewers, logs, option files) are refused.
-_FILE_WORDS = ("options_file", "view", "log", "history", "dump", "draw", "save", "load")
+# Options that read or write files (viewers, logs, option files) or start programs (debuggers) are refused.
+_FILE_WORDS = ("options_file", "view", "log", "history", "dump", "draw", "save", "load", "info", "debugger", "malloc",
+               "python")
 
 
 def check_options(text: str) -> str:
@@ -40,7 +41,7 @@ def check_options(text: str) -> str:
         if not _NAME.fullmatch(name):
             raise ValueError(f"{name!r} is not an option name (-letters, digits, _)")
         if any(w in name.lower() for w in _FILE_WORDS):
-            raise ValueError(f"{name}: options that read or write files are not allowed")
+            raise ValueError(f"{name}: options that read or write files or start programs are not allowed")
         if not _VALUE.fullmatch(value):
             raise ValueError(f"value {value!r} of {name}: only letters, digits and _ . + , - are allowed")
     return text
@@ -49,8 +50,8 @@ def check_options(text: str) -> str:
 def launch_options(pc: str, options: str, reuse: bool) -> list[str]:
     """FreeFEM arguments of the PETSc path (the -D switch loads the plugin only for these scenes).
 
-    >>> launch_options("gamg", "", True)
-    ['-DWITHPETSC=1', '-petsc_pc', 'gamg', '-petsc_options', '-wendel_pc_reuse 1']
+    >>> launch_options("ml", "", True)
+    ['-DWITHPETSC=1', '-petsc_pc', 'ml', '-petsc_options', '-wendel_pc_reuse 1']
     """
     extra = f"-wendel_pc_reuse {int(reuse)}" + (f" {options}" if options.strip() else "")
     return ["-DWITHPETSC=1", "-petsc_pc", pc, "-petsc_options", extra]

@@ -137,7 +137,7 @@ class Loading(Strict):
 class Petsc(Strict):
     """The PETSc solver (numerics.solver = "petsc"): CG + a preconditioner preset, PETSc options on top."""
 
-    pc: PcName = Field("gamg", description=f"preconditioner: {', '.join(PRECONDITIONERS)}")
+    pc: PcName = Field("ml", description=f"preconditioner: {', '.join(PRECONDITIONERS)}")
     options: str = Field("", description="more PETSc options, \"-name value\" pairs (e.g. \"-ksp_rtol 1e-8\"); "
                          "they override the preset; no option that reads or writes files")
     reuse: bool = Field(True, description="keep the preconditioner across Newton steps and increments while "
