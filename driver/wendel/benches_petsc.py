@@ -1,12 +1,14 @@
 """PETSc against Jacobi-CG on the project's own Newton matrices (``wendel bench petsc``).
 
-The step-42 ball (workflows/ball-indent.toml: contact + plasticity, graded gmsh meshes) at two sizes,
-with ``solver = "cg"`` (Jacobi-CG in the FreeFEM language, masked constraint rows) and ``solver = "petsc"``
-with each preconditioner preset, the kept preconditioner switched off once for GAMG; then the other scenes
-that use CG (hertz-3d, stamp-indent) with CG and the default PETSc preset. Rows give the seconds per Newton
-step of the linear solve (CSR conversion, preconditioner setup and Krylov iterations included), of the
-assembly and of the constitutive update, the Krylov iterations per Newton step, the Newton iterations and
-the contact force (which must not depend on the solver). One FreeFEM process per row, one rank.
+The step-42 ball (workflows/ball-indent.toml: contact + plasticity, graded gmsh meshes) at 17k DoFs with
+``solver = "cg"`` (Jacobi-CG in the FreeFEM language, masked constraint rows) and ``solver = "petsc"`` with each
+preconditioner preset, ML without the kept preconditioner and ML on 2 ranks; at 47k DoFs with CG, ML and GAMG;
+then the other scenes that use CG (hertz-3d, stamp-indent) with CG and the default preset. Rows give wall
+seconds per Newton step of the linear solve (CSR conversion, preconditioner setup and Krylov iterations
+included), of the assembly (and of the tangent matrix alone) and of the constitutive update, the Krylov
+iterations per Newton step, the Newton iterations, the contact force (which must not depend on the solver) and
+the CPU time of the FreeFEM processes for the whole run (the steadier figure on a shared machine). One row
+alone: ``python -m wendel.benches_petsc SCENE H SOLVER [PC [REUSE [RANKS [OPTIONS]]]]``.
 """
 
 from __future__ import annotations
@@ -28,10 +30,10 @@ def measure(scene_path: Path, out: Path, solver: str, pc: str = DEFAULT_PC, reus
     """Run one scene with one solver; return its row (wall times per Newton step by phase, CPU time of the
     FreeFEM processes for the whole run: on a shared machine the steadier figure)."""
     scene = load(scene_path)
-    scene.numerics.ranks = ranks
     if h is not None:
         scene.geometry.h = h
     scene.numerics.solver = solver
+    scene.numerics.ranks = ranks                 # after the solver: the scene check ties ranks to it
     scene.numerics.petsc.pc = pc
     scene.numerics.petsc.reuse = reuse
     scene.numerics.petsc.options = options

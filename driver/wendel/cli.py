@@ -39,8 +39,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--update", type=Path, metavar="README", help="rewrite the table in this file instead")
 
     p = sub.add_parser("bench", help="benchmarks; results into results/bench/")
-    p.add_argument("names", nargs="*", help="benchmarks to run: cylinder, elasticity, obstacle, remesh, step42, "
-                   "thermal (the default: all of these), step42-dealii (only when named)")
+    p.add_argument("names", nargs="*", help="benchmarks to run: cylinder, elasticity, obstacle, petsc, remesh, "
+                   "step42, thermal (the default: all of these), step42-dealii (only when named)")
     p.add_argument("--quick", action="store_true", help="small sizes only")
 
     args = parser.parse_args(argv)
