@@ -14,6 +14,8 @@ from typing import Callable
 from .labels import LABELS
 
 BUILDERS: dict[str, Callable[..., "Built"]] = {}
+# The boundary names a builder labels, as a function of its parameters (builders that declare them).
+BOUNDARIES: dict[str, Callable[..., list[str]]] = {}
 
 
 @dataclasses.dataclass
@@ -27,11 +29,17 @@ class Built:
     elements: int
 
 
-def register(name: str):
-    """Register a builder under ``name`` (used as ``geometry.builder`` in scene files)."""
+def register(name: str, boundaries: list[str] | Callable[..., list[str]] | None = None):
+    """Register a builder under ``name`` (used as ``geometry.builder`` in scene files).
+
+    ``boundaries`` names the boundaries it labels (a list, or a function of the builder's keywords), so a
+    scene's boundary names are checked before anything is meshed.
+    """
 
     def wrap(func):
         BUILDERS[name] = func
+        if boundaries is not None:
+            BOUNDARIES[name] = boundaries if callable(boundaries) else (lambda **_: list(boundaries))
         return func
 
     return wrap
@@ -44,6 +52,27 @@ def build(name: str, path: Path, **params) -> Built:
     return BUILDERS[name](Path(path), **params)
 
 
+def start_gmsh():
+    """Initialize gmsh (quiet, one thread, reproducible) without taking over the process's signals.
+
+    gmsh's initialize resets SIGINT and SIGTERM to their defaults at the C level (also with
+    ``interruptible=False``), so Ctrl-C and SIGTERM would kill the driver at once and leave FreeFEM
+    running: Python's handlers are installed again afterwards.
+    """
+    import signal
+
+    import gmsh
+
+    handlers = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    gmsh.initialize(["-noenv"], readConfigFiles=False, interruptible=False)
+    for s, h in handlers.items():
+        signal.signal(s, h if h is not None else signal.SIG_DFL)
+    gmsh.option.setNumber("General.Terminal", 0)
+    gmsh.option.setNumber("General.NumThreads", 1)
+    gmsh.option.setNumber("Mesh.RandomSeed", 1)
+    return gmsh
+
+
 class _Session:
     """A gmsh session that always finalizes, quiet unless asked."""
 
@@ -51,12 +80,7 @@ class _Session:
         self.name = name
 
     def __enter__(self):
-        import gmsh
-
-        gmsh.initialize(["-noenv"], readConfigFiles=False)
-        gmsh.option.setNumber("General.Terminal", 0)
-        gmsh.option.setNumber("General.NumThreads", 1)
-        gmsh.option.setNumber("Mesh.RandomSeed", 1)
+        gmsh = start_gmsh()
         gmsh.model.add(self.name)
         self.gmsh = gmsh
         return gmsh
@@ -134,7 +158,7 @@ def _tag_boxes(gmsh, dim: int, lo, hi, names: list[str]):
     gmsh.model.addPhysicalGroup(dim, vols, LABELS["domain"], "domain")
 
 
-@register("rectangle")
+@register("rectangle", ["left", "right", "bottom", "top"])
 def rectangle(path: Path, x=(0.0, 1.0), y=(0.0, 1.0), h=0.1, refine=None, structured=False) -> Built:
     """A rectangle [x0, x1] x [y0, y1] (m) with boundaries left, right, bottom, top.
 
@@ -158,7 +182,7 @@ def rectangle(path: Path, x=(0.0, 1.0), y=(0.0, 1.0), h=0.1, refine=None, struct
         return _write(gmsh, path, 2, names)
 
 
-@register("box")
+@register("box", ["left", "right", "front", "back", "bottom", "top"])
 def box(path: Path, x=(0.0, 1.0), y=(0.0, 1.0), z=(0.0, 1.0), h=0.1, refine=None) -> Built:
     """A box [x0, x1] x [y0, y1] x [z0, z1] (m) with boundaries left, right, front, back, bottom, top."""
     names = ["left", "right", "front", "back", "bottom", "top"]
@@ -171,7 +195,7 @@ def box(path: Path, x=(0.0, 1.0), y=(0.0, 1.0), z=(0.0, 1.0), h=0.1, refine=None
         return _write(gmsh, path, 3, names)
 
 
-@register("ring")
+@register("ring", lambda quarter=True, **_: ["inner", "outer"] + (["symmetry_x", "symmetry_y"] if quarter else []))
 def ring(path: Path, r_inner=1.0, r_outer=1.3, h=0.05, quarter=True) -> Built:
     """A thick-walled cylinder cross-section (plane strain): a quarter ring by default.
 
@@ -207,7 +231,7 @@ def ring(path: Path, r_inner=1.0, r_outer=1.3, h=0.05, quarter=True) -> Built:
         return _write(gmsh, path, 2, names)
 
 
-@register("disk")
+@register("disk", ["outer"])
 def disk(path: Path, radius=1.0, center=(0.0, 0.0), h=0.1) -> Built:
     """A full disk of ``radius`` (m) around ``center``: a bar's circular cross-section; boundary outer."""
     with _Session("disk") as gmsh:

@@ -5,7 +5,7 @@ import sys
 from pathlib import Path
 
 from wendel.cli import main
-from wendel.schema import KEYS_BEGIN, KEYS_END, keys_table
+from wendel.scene.schema import KEYS_BEGIN, KEYS_END, keys_table
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -87,7 +87,7 @@ def test_a_used_run_folder_is_refused(tmp_path, capsys):
 
 
 def test_parallel_runs_of_one_scene_get_their_own_folders(tmp_path, monkeypatch):
-    import wendel.run as runmod
+    import wendel.loop.quasistatic as runmod
 
     monkeypatch.setattr(runmod, "RESULTS", tmp_path)
     dirs = [runmod._new_run_dir(Path("workflows/smoke.toml"), smoke=True) for _ in range(3)]

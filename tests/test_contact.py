@@ -12,9 +12,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from wendel import freefem, output
+from wendel import freefem
+from wendel.results import vtu as output
 from wendel.meshes import build
-from wendel.run import run
+from wendel.loop import run
 
 from conftest import ROOT, WORKFLOWS
 
@@ -97,7 +98,7 @@ def test_radial_obstacle_converges_at_the_expected_rate(meshes, tmp_path):
 
 def contact_2d(meshes, out: Path, mesh: str, *extra, ranks: int = 1, dirichlet=("3 0 0", "3 1 0")) -> dict:
     opts = ["-mesh", meshes[mesh], "-mat_E", 1.0, "-mat_nu", 0.3, *tables(out.parent / (out.name + "-tables"), list(dirichlet))]
-    return solve("solve-2d-contact.edp", out, *opts, *extra, ranks=ranks)
+    return solve("mechanics.edp", out, "-Ddimension=2", "-DWITHCONTACT=1", *opts, *extra, ranks=ranks)
 
 
 def test_hertz_3d_sphere(tmp_path):
@@ -145,7 +146,7 @@ def test_obstacle_that_never_touches_gives_the_elastic_solution(meshes, tmp_path
     grav = ("-body_id", 1, "-body_fy", -0.01)
     rc = contact_2d(meshes, tmp_path / "c", "block", *grav, "-contact_obstacle", 1, "-contact_cy", 0.1)
     opts = ["-mesh", meshes["block"], "-mat_E", 1.0, "-mat_nu", 0.3, *tables(tmp_path / "e-tables", ["3 0 0", "3 1 0"]), *grav]
-    solve("solve-2d.edp", tmp_path / "e", *opts)
+    solve("mechanics.edp", tmp_path / "e", "-Ddimension=2", *opts)
     assert rc["contact_active_nodes"] == 0 and rc["contact_force"] == pytest.approx(0, abs=1e-14)
     uc = output.read_array(tmp_path / "c" / "inc-0001" / "u.node.txt")
     ue = output.read_array(tmp_path / "e" / "inc-0001" / "u.node.txt")
@@ -198,7 +199,7 @@ def test_3d_obstacles(meshes, tmp_path, shape):
     out = tmp_path / shape
     opts = ["-mesh", meshes["box"], "-mat_E", 1.0, "-mat_nu", 0.3,
             *tables(tmp_path / "t", ["3 0 0", "3 1 0", "3 2 0"]), *extra]
-    rec = solve("solve-3d-contact.edp", out, *opts)
+    rec = solve("mechanics.edp", out, "-Ddimension=3", "-DWITHCONTACT=1", *opts)
     assert 0 < rec["contact_active_nodes"] < rec["contact_nodes"]
     assert all(rec[k] < 1e-8 for k in KKT), {k: rec[k] for k in KKT}
     active = output.read_array(out / "inc-0001" / "contact_active.node.txt")
@@ -226,7 +227,7 @@ def test_membrane_obstacle_scenes_run(tmp_path, name):
 
 
 def test_radial_study_writes_error_against_runtime(tmp_path):
-    from wendel.study import study
+    from wendel.results.study import study
 
     root = study(WORKFLOWS / "obstacle-radial.toml", levels=3, smoke=True, out=tmp_path / "study",
                  progress=lambda *_: None)

@@ -3,7 +3,7 @@
 import json
 
 import numpy as np
-from wendel.run import StepCutError, run
+from wendel.loop import StepCutError, run
 
 from conftest import SMOKE_SCENE, WORKFLOWS
 

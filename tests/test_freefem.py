@@ -35,7 +35,7 @@ def test_bad_option_reported_by_the_module(tmp_path):
     meshes.build("rectangle", tmp_path / "m.msh", h=0.5)
     (tmp_path / "loads.txt").write_text("1\n1.0\n")
     with pytest.raises(freefem.FreeFemError, match=r"elasticity.idp: -mat_E must be > 0, got -3"):
-        freefem.run("solve-2d.edp", ["-mesh", str(tmp_path / "m.msh"), "-loads", str(tmp_path / "loads.txt"),
+        freefem.run("mechanics.edp", ["-Ddimension=2", "-mesh", str(tmp_path / "m.msh"), "-loads", str(tmp_path / "loads.txt"),
                                      "-mat_E", "-3"], tmp_path / "out")
 
 

@@ -11,8 +11,8 @@ import meshio
 import numpy as np
 import pytest
 
-from wendel import output
-from wendel.run import run
+from wendel.results import vtu as output
+from wendel.loop import run
 
 from conftest import WORKFLOWS
 
@@ -114,7 +114,7 @@ def test_adaptive_steps_cut_grow_and_land_on_the_targets(tmp_path, scene_file):
     s = json.loads((root / "summary.json").read_text())
     assert s["step_cuts"] >= 1
     # after an easy increment the next attempted step is larger than the one just taken
-    from wendel.run import State, grow_step
+    from wendel.loop import State, grow_step
     from wendel.scene import parse
     import tomllib
 
@@ -123,7 +123,7 @@ def test_adaptive_steps_cut_grow_and_land_on_the_targets(tmp_path, scene_file):
     inc = tmp_path / "g" / "fem" / "inc-0001"
     inc.mkdir(parents=True)
     (inc / "record.json").write_text(json.dumps({"newton_iterations": 2}))
-    from wendel.run import RunFiles
+    from wendel.loop import RunFiles
     grow_step(scene, st, RunFiles(tmp_path / "g"))
     assert st.step == pytest.approx(0.15)
     (inc / "record.json").write_text(json.dumps({"newton_iterations": 9}))
@@ -133,7 +133,7 @@ def test_adaptive_steps_cut_grow_and_land_on_the_targets(tmp_path, scene_file):
 
 
 def test_progress_heartbeat_reports_the_running_newton_iteration(tmp_path):
-    from wendel.run import _Progress
+    from wendel.loop.progress import _Progress
 
     inc = tmp_path / "inc-0003"
     inc.mkdir()

@@ -10,7 +10,7 @@ import sys
 
 import pytest
 
-from wendel.run import run_scene
+from wendel.loop import run_scene
 from wendel.scene import load
 
 from conftest import WORKFLOWS

@@ -12,8 +12,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from wendel import freefem, output
-from wendel.run import StepCutError, run
+from wendel import freefem
+from wendel.results import vtu as output
+from wendel.loop import StepCutError, run
 
 from conftest import ROOT, WORKFLOWS
 
@@ -64,13 +65,14 @@ def cube_msh(path: Path, n: int = 1) -> Path:
     return path
 
 
-def solve(tmp: Path, entry: str, mesh: Path, loads, bc, trac=None, **opts) -> Path:
-    """One FreeFEM launch of ``entry``; returns the output folder (exit code 4 is allowed)."""
+def solve(tmp: Path, macros: list[str], mesh: Path, loads, bc, trac=None, **opts) -> Path:
+    """One FreeFEM launch of edp/mechanics.edp with the -D ``macros``; returns the output folder (exit code 4 is
+    allowed)."""
     out = tmp / "out"
     out.mkdir(parents=True, exist_ok=True)
     (tmp / "loads.txt").write_text(f"{len(loads)}\n" + "".join(f"{f!r}\n" for f in loads))
     (tmp / "bc.txt").write_text(f"{len(bc)}\n" + "".join(f"{r}\n" for r in bc))
-    args = ["mpirun", "-np", "1", "FreeFem++-mpi", "-nw", "-v", "0", str(ROOT / "edp" / entry), "-out", str(out),
+    args = ["mpirun", "-np", "1", "FreeFem++-mpi", "-nw", "-v", "0", str(ROOT / "edp" / "mechanics.edp"), *macros, "-out", str(out),
             "-mesh", str(mesh), "-loads", str(tmp / "loads.txt"), "-bc", str(tmp / "bc.txt"),
             "-mat_E", repr(E), "-mat_nu", repr(NU)]
     if trac:
@@ -144,7 +146,7 @@ def cube(tmp_path_factory):
                      "plast_jc_Tr": JC["Tr"], "plast_jc_Tm": JC["Tm"], "plast_T": 700.0, "plast_load_time": 1e-3}),
 ])
 def test_uniaxial_curve_matches_closed_form(tmp_path, cube, law, opts):
-    out = solve(tmp_path, "solve-3d-plasticity.edp", cube, LOADS, UNIAXIAL_BC, **opts)
+    out = solve(tmp_path, ["-Ddimension=3", "-DWITHPLASTICITY=1"], cube, LOADS, UNIAXIAL_BC, **opts)
     recs = records(out)
     assert len(recs) == len(LOADS)
     strains = [(lf, lf * DELTA) for lf in LOADS]
@@ -205,7 +207,7 @@ def ring(tmp: Path, h: float) -> Path:
 
 
 def test_newton_converges_quadratically_with_linear_hardening(tmp_path):
-    out = solve(tmp_path, "solve-2d-plasticity.edp", ring(tmp_path, 0.05), [0.7], CYL_BC,
+    out = solve(tmp_path, ["-Ddimension=2", "-DWITHPLASTICITY=1"], ring(tmp_path, 0.05), [0.7], CYL_BC,
                 trac=["7 0 0 0 100e6"], plast_law=1, plast_sigma0=SIGMA0, plast_H=5e9, newton_tol=1e-12)
     rows = np.genfromtxt(out / "inc-0001" / "newton.csv", delimiter=",", names=True)
     r = rows["relative_residual"]
@@ -274,7 +276,7 @@ def test_cylinder_scene_records_the_plastic_radius_error(tmp_path, quiet):
     assert "error_plastic_radius" in json.dumps(s)
     # the cylinder bench's per-increment costs: differences of the cumulative record times add up
     from wendel.bench import BENCHES
-    from wendel.benches_plasticity import increment_costs
+    from wendel.bench.cylinder import increment_costs
 
     assert "cylinder" in BENCHES
     costs = increment_costs(root / "fem")

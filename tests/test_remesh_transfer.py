@@ -19,7 +19,7 @@ try:
 except ImportError:
     sys.path[:0] = [str(ROOT / "driver"), str(ROOT)]
 
-from wendel import quality, remesh, transfer  # noqa: E402
+from wendel.remesh import mesher as remesh, quality, transfer  # noqa: E402
 
 try:
     from wendel.meshes.labels import LABELS
@@ -288,16 +288,16 @@ def test_active_set_guess(rect):
 
 # --- FreeFEM reads the remeshed file -------------------------------------------------------------
 
-def _freefem(entry, mesh, tmp_path, bc_rows):
+def _freefem(dimension, mesh, tmp_path, bc_rows):
     (tmp_path / "out").mkdir()
     (tmp_path / "loads.txt").write_text("1\n1.0\n")
     (tmp_path / "bc.txt").write_text(f"{len(bc_rows)}\n" + "".join(f"{r}\n" for r in bc_rows))
-    cmd = (f". {ROOT}/edp/env.sh; mpirun -np 1 FreeFem++-mpi -nw -v 0 {ROOT}/edp/{entry} -out {tmp_path}/out "
+    cmd = (f". {ROOT}/edp/env.sh; mpirun -np 1 FreeFem++-mpi -nw -v 0 {ROOT}/edp/mechanics.edp -Ddimension={dimension} -out {tmp_path}/out "
            f"-mesh {mesh} -loads {tmp_path}/loads.txt -bc {tmp_path}/bc.txt -mat_E 1 -mat_nu 0.3")
     run = subprocess.run(["bash", "-c", cmd], capture_output=True, text=True, timeout=120, cwd=ROOT)
     inc = tmp_path / "out" / "inc-0001"
     assert (inc / "done").exists(), run.stdout[-2000:] + run.stderr[-2000:]
-    from wendel.output import read_array
+    from wendel.results.vtu import read_array
 
     u = read_array(inc / "u.node.txt")  # interleaved [ux0, uy0, ...]
     return u
@@ -312,7 +312,7 @@ def test_freefem_reads_the_remeshed_2d_file_with_its_labels(rect, tmp_path):
     new = tmp_path / "new.msh"
     remesh.remesh(_shear(pts), rect, new, h=0.1)
     # left clamped, right pulled by 0.01: both labels must exist for a non-singular, non-zero solution
-    u = _freefem("solve-2d.edp", new, tmp_path, ["1 0 0", "1 1 0", "2 0 0.01"])
+    u = _freefem(2, new, tmp_path, ["1 0 0", "1 1 0", "2 0 0.01"])
     npts, _, _, _, _ = _read(new)
     assert len(u) == 2 * len(npts)
     assert u[0::2].max() == pytest.approx(0.01, rel=1e-6)
@@ -323,7 +323,7 @@ def test_freefem_reads_the_remeshed_3d_file_with_its_labels(box, tmp_path):
     pts, _, _, _, _ = _read(box)
     new = tmp_path / "new.msh"
     remesh.remesh(_shear(pts), box, new, h=0.25)
-    u = _freefem("solve-3d.edp", new, tmp_path, ["1 0 0", "1 1 0", "1 2 0", "2 0 0.01"])
+    u = _freefem(3, new, tmp_path, ["1 0 0", "1 1 0", "1 2 0", "2 0 0.01"])
     npts, _, _, _, _ = _read(new)
     assert len(u) == 3 * len(npts)
     assert u[0::3].max() == pytest.approx(0.01, rel=1e-6)

@@ -115,8 +115,8 @@ def test_values_reach_freefem_as_numbers_only(tmp_path):
     """A scene string never reaches FreeFEM as code: every option value is a number, a validated name or a
     path the driver wrote."""
     from conftest import WORKFLOWS
-    from wendel.run import RunFiles, options
-    from wendel.schema import SOLVERS
+    from wendel.loop import RunFiles, options
+    from wendel.scene.schema import SOLVERS
 
     for path in sorted(WORKFLOWS.glob("*.toml")):
         scene = load(path)

@@ -7,9 +7,9 @@ import meshio
 import numpy as np
 import pytest
 
-from wendel import output
-from wendel.run import run
-from wendel.study import study
+from wendel.results import vtu as output
+from wendel.loop import run
+from wendel.results.study import study
 
 from conftest import WORKFLOWS
 

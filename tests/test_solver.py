@@ -9,7 +9,7 @@ import json
 
 import pytest
 
-from wendel.run import run_scene
+from wendel.loop import run_scene
 from wendel.scene import load
 
 from conftest import WORKFLOWS

@@ -12,9 +12,9 @@ import meshio
 import numpy as np
 import pytest
 
-from wendel import output
-from wendel.blocks.plasticity import Plasticity, options, step42_to_von_mises
-from wendel.run import run
+from wendel.results import vtu as output
+from wendel.scene.blocks.plasticity import Plasticity, options, step42_to_von_mises
+from wendel.loop import run
 from wendel.scene import load
 
 from conftest import WORKFLOWS
@@ -96,7 +96,7 @@ def test_ball_indent_same_result_on_1_and_2_ranks(tmp_path):
         scene.numerics.solver = "ffddm"
         scene.numerics.ranks = ranks
         scene.output.png = False
-        from wendel.run import run_scene
+        from wendel.loop import run_scene
 
         root = run_scene(scene, WORKFLOWS / "ball-indent.toml", tmp_path / f"np{ranks}", progress=lambda *_: None)
         recs.append(summary(root)["last_increment"])
@@ -109,7 +109,7 @@ def test_ball_indent_same_result_on_1_and_2_ranks(tmp_path):
 
 
 def test_study_plots_the_force_next_to_dealii(tmp_path):
-    from wendel.study import study
+    from wendel.results.study import study
 
     root = study(WORKFLOWS / "ball-indent.toml", levels=2, smoke=True, out=tmp_path / "s", progress=lambda *_: None)
     import csv

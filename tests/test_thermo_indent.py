@@ -5,8 +5,8 @@ import json
 import meshio
 import numpy as np
 
-from wendel import output
-from wendel.run import run
+from wendel.results import vtu as output
+from wendel.loop import run
 
 from conftest import WORKFLOWS
 

@@ -10,8 +10,8 @@ import math
 
 import pytest
 
-from wendel.blocks.torsion import circular_torque
-from wendel.run import run
+from wendel.scene.blocks.torsion import circular_torque
+from wendel.loop import run
 from wendel.scene import SceneError
 
 from conftest import WORKFLOWS
@@ -55,7 +55,7 @@ def test_circular_bar_matches_closed_form(tmp_path, quiet):
 
 
 def test_study_converges(tmp_path):
-    from wendel.study import study
+    from wendel.results.study import study
 
     root = study(WORKFLOWS / "torsion.toml", levels=3, smoke=True, out=tmp_path / "study", progress=lambda *_: None)
     with open(root / "study.csv") as f:

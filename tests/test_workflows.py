@@ -4,7 +4,7 @@ import json
 
 import pytest
 
-from wendel.run import StepCutError, run
+from wendel.loop import StepCutError, run
 
 from conftest import WORKFLOWS
 

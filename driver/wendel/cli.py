@@ -1,15 +1,42 @@
 """Command line: ``wendel run | study | check | bench``.
 
-Exit codes: 0 done, 1 the run failed (FreeFEM error, no convergence), 2 bad input (scene, options).
+Exit codes: 0 done, 1 the run failed (FreeFEM error, no convergence, disk full), 2 bad input (scene,
+options), 130 interrupted (Ctrl-C or SIGTERM; the run resumes with ``wendel run --resume DIR``).
+Only what a command needs is imported: ``wendel check`` and ``wendel keys`` never load the solver side.
 """
 
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
 from pathlib import Path
 
 from . import __version__
+
+
+def ranks_option(text: str) -> int:
+    """``--np``: an integer from 1 to 64 (numerics.ranks' range)."""
+    try:
+        n = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
+    if not 1 <= n <= 64:
+        raise argparse.ArgumentTypeError(f"{n} is not a number of ranks from 1 to 64")
+    return n
+
+
+def printable(text: str) -> str:
+    r"""``text`` with control characters escaped, so scene strings cannot drive the terminal.
+
+    >>> printable("a\x1b[2Jb\tc")
+    'a\\x1b[2Jb\tc'
+    """
+    return "".join(c if c.isprintable() or c in "\n\t" else repr(c)[1:-1] for c in str(text))
+
+
+def _terminate(signum, frame):
+    raise KeyboardInterrupt        # SIGTERM stops a run like Ctrl-C: FreeFEM too, resumable, exit 130
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -20,7 +47,7 @@ def main(argv: list[str] | None = None) -> int:
 
     p = sub.add_parser("run", help="run a scene")
     p.add_argument("scene", nargs="?", help="scene file (TOML)")
-    p.add_argument("--np", type=int, help="MPI ranks (overrides numerics.ranks; >1 uses ffddm)")
+    p.add_argument("--np", type=ranks_option, help="MPI ranks, 1 to 64 (overrides numerics.ranks; >1 uses ffddm)")
     p.add_argument("--smoke", action="store_true", help="run at the scene's tiny smoke size")
     p.add_argument("--out", type=Path, help="run folder (default results/<scene>/<time>)")
     p.add_argument("--resume", type=Path, metavar="RUN_DIR", help="continue a run from its last checkpoint")
@@ -29,7 +56,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("scene")
     p.add_argument("--levels", type=int, default=3, help="number of meshes (h, h/2, ...)")
     p.add_argument("--smoke", action="store_true", help="start from the smoke size")
-    p.add_argument("--np", type=int)
+    p.add_argument("--np", type=ranks_option)
     p.add_argument("--out", type=Path)
 
     p = sub.add_parser("check", help="validate a scene file without running it")
@@ -44,30 +71,38 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--quick", action="store_true", help="small sizes only")
 
     args = parser.parse_args(argv)
+    from .errors import DiskFull, Interrupted, StepCutError
     from .freefem import FreeFemError, NewtonFailure
-    from .run import StepCutError
     from .scene import SceneError
+    if args.command in ("run", "study"):
+        signal.signal(signal.SIGTERM, _terminate)
     try:
         if args.command == "check":
             from .scene import load
             for s in args.scene:
                 scene = load(s)
-                print(f"{s}: ok ({scene.description}; blocks: {', '.join(scene.blocks) or 'elastic'})")
+                print(printable(f"{s}: ok ({scene.description}; blocks: {', '.join(scene.blocks) or 'elastic'})"))
             return 0
         if args.command == "run":
-            from .run import run
+            from .loop import run
             if args.resume is None and args.scene is None:
                 parser.error("run needs a scene file or --resume RUN_DIR")
+            if args.resume is not None:
+                ignored = [f"the scene file {args.scene}"] * bool(args.scene) + ["--np"] * (args.np is not None) \
+                    + ["--smoke"] * args.smoke + ["--out"] * (args.out is not None)
+                if ignored:
+                    print(printable(f"wendel: ignored with --resume (the run goes on with its own settings): "
+                                    f"{', '.join(ignored)}"))
             root = run(args.scene or "", smoke=args.smoke, ranks=args.np, out=args.out, resume=args.resume)
             _print_summary(root)
             return 0
         if args.command == "study":
-            from .study import study
+            from .results.study import study
             root = study(args.scene, levels=args.levels, smoke=args.smoke, ranks=args.np, out=args.out)
             print(f"study written to {root}")
             return 0
         if args.command == "keys":
-            from .schema import keys_table, update_readme
+            from .scene.schema import keys_table, update_readme
             if args.update:
                 print(f"{args.update}: {'updated' if update_readme(args.update) else 'up to date'}")
             else:
@@ -79,14 +114,20 @@ def main(argv: list[str] | None = None) -> int:
             print(f"benchmarks written to {root}")
             return 0
     except SceneError as exc:
-        print(f"wendel: bad scene:\n{exc}", file=sys.stderr)
+        print(printable(f"wendel: bad scene:\n{exc}"), file=sys.stderr)
         return 2
     except (FileNotFoundError, ValueError, KeyError) as exc:
-        print(f"wendel: bad input: {exc}", file=sys.stderr)
+        print(printable(f"wendel: bad input: {exc}"), file=sys.stderr)
         return 2
-    except (FreeFemError, NewtonFailure, StepCutError) as exc:
-        print(f"wendel: run failed: {exc}", file=sys.stderr)
+    except (FreeFemError, NewtonFailure, StepCutError, DiskFull) as exc:
+        print(printable(f"wendel: run failed: {exc}"), file=sys.stderr)
         return 1
+    except Interrupted as exc:
+        print(printable(f"wendel: {exc}"), file=sys.stderr)
+        return 130
+    except KeyboardInterrupt:
+        print("wendel: interrupted", file=sys.stderr)
+        return 130
     return 0
 
 
@@ -105,6 +146,8 @@ def _print_summary(root: Path) -> None:
     if errors:
         print("errors against the closed form: " + ", ".join(f"{k.removeprefix('error_')} {v:.3e}"
                                                              for k, v in errors.items()))
+    for w in s.get("warnings") or []:
+        print(printable(f"warning: {w}"))
     print(f"results: {root}  (ParaView: {root / 'results.pvd'})")
 
 

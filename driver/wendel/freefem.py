@@ -1,7 +1,9 @@
 """Run FreeFEM entry scripts: environment, MPI launch, time limit, log, errors turned into exceptions.
 
-Every launch is ``mpirun -np N FreeFem++-mpi -nw -v 0 edp/<entry>.edp -key value ...`` (one code path
-for 1 and N ranks; 0.16 s start on one rank here). FreeFEM's output goes to a log file; results come
+Every launch is ``mpirun -np N FreeFem++-mpi -nw -v 0 edp/<entry>.edp -out DIR -DNAME=VALUE ... -key value ...``
+(one code path for 1 and N ranks; 0.16 s start on one rank here). ``-D`` arguments define FreeFEM macros
+before the script compiles (they choose the modules, :func:`wendel.loop.launch.macros`); the others are
+read by ``getARGV`` at run time. FreeFEM's output goes to a log file; results come
 back as files (the exit code says which file to read), never scraped from stdout except to quote a
 compile or runtime error.
 """
@@ -11,8 +13,10 @@ from __future__ import annotations
 import json
 import os
 import re
+import shutil
 import signal
 import subprocess
+import tempfile
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -76,16 +80,35 @@ _CURRENT = re.compile(r"current line = (\d+)")
 _EXEC = re.compile(r"(Exec error : .*|Compile error : .*|Load error : .*|.*Error.*)")
 
 
-def explain_log(text: str, script: Path) -> tuple[str, str | None, int | None]:
-    """Turn FreeFEM's log into (message, file, line).
+def _project_file(name: str, script: Path) -> str | None:
+    """``name`` if it is an existing .edp/.idp file of the project (edp/) or beside the entry script run,
+    else None: a path printed in the log by anything else (a run folder named like an error message) is
+    not a location."""
+    path = Path(name)
+    for root in (EDP, script.parent):
+        full = path if path.is_absolute() else root / path
+        try:
+            full = full.resolve()
+        except OSError:
+            continue
+        if full.suffix in (".edp", ".idp") and full.is_relative_to(root.resolve()) and full.is_file():
+            return name
+    return None
 
-    >>> explain_log(" Error line number 2, in file t2.edp, before  token *\\nsyntax error\\n", Path("x.edp"))
-    ('t2.edp:2: syntax error (before token *)', 't2.edp', 2)
+
+def explain_log(text: str, script: Path) -> tuple[str, str | None, int | None]:
+    """Turn FreeFEM's log into (message, file, line); only the project's own .edp/.idp files are locations.
+
+    >>> explain_log(" Error line number 2, in file lib/bc.idp, before  token *\\nsyntax error\\n", Path("x.edp"))
+    ('lib/bc.idp:2: syntax error (before token *)', 'lib/bc.idp', 2)
+    >>> explain_log(" Error line number 1, in file /etc/shadow, before  token *\\n", Path("x.edp"))[1:]
+    (None, None)
     """
-    m = _COMPILE.search(text)
-    if m:
+    for m in _COMPILE.finditer(text):
         line, file, token = int(m.group(1)), m.group(2).strip(), m.group(3).strip()
         file = file.split(" in ")[-1] if file.startswith("macro:") else file
+        if _project_file(file, script) is None:
+            continue
         after = text[m.end():].strip().splitlines()
         what = after[0].strip() if after else "compile error"
         return f"{file}:{line}: {what} (before token {token})", file, line
@@ -113,13 +136,19 @@ def run(entry: str, options: list[str], out_dir: Path, ranks: int = 1, timeout: 
     log = log or out_dir / "freefem.log"
     for stale in ("error.txt", "failed.json"):
         (out_dir / stale).unlink(missing_ok=True)
-    cmd = ["mpirun", "-np", str(ranks), "FreeFem++-mpi", "-nw", "-v", "0", str(script),
-           "-out", str(out_dir), *options]
+    # setpriv: mpirun gets SIGTERM (and stops its ranks) when the driver dies, even by kill -9
+    cmd = ["setpriv", "--pdeathsig", "TERM", "mpirun", "-np", str(ranks), "FreeFem++-mpi", "-nw", "-v", "0",
+           str(script), "-out", str(out_dir), *options]
+    env = environment()
+    # Open MPI's session folder of this launch alone: concurrent runs (a sweep) sharing one raced
+    # ("orte_session_dir failed") when the first to finish removed it
+    session = tempfile.mkdtemp(prefix="wendel-ompi-")
+    env.setdefault("OMPI_MCA_orte_tmpdir_base", session)
     t0 = time.perf_counter()
     with open(log, "a") as flog:
         flog.write("$ " + " ".join(cmd) + "\n")
         flog.flush()
-        proc = subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=flog, stderr=subprocess.STDOUT, env=environment(),
+        proc = subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=flog, stderr=subprocess.STDOUT, env=env,
                                 start_new_session=True, cwd=out_dir)
         try:
             rc = proc.wait(timeout=timeout)
@@ -130,6 +159,8 @@ def run(entry: str, options: list[str], out_dir: Path, ranks: int = 1, timeout: 
         except BaseException:
             _kill(proc)
             raise
+        finally:
+            shutil.rmtree(session, ignore_errors=True)
     wall = time.perf_counter() - t0
     if rc == 0:
         return Launch(wall, cmd)
@@ -138,7 +169,7 @@ def run(entry: str, options: list[str], out_dir: Path, ranks: int = 1, timeout: 
     if (out_dir / "error.txt").is_file():
         raise FreeFemError((out_dir / "error.txt").read_text().strip(), str(script), None, log)
     text = log.read_text(errors="replace")
-    text = text[text.rfind("$ mpirun"):]
+    text = text[text.rfind("$ " + " ".join(cmd)):]       # this launch's part of the log
     message, file, line = explain_log(text, script)
     raise FreeFemError(f"FreeFEM error (exit code {rc}) in {message}\n(full log: {log})", file, line, log)
 

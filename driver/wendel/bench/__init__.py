@@ -1,0 +1,79 @@
+"""Benchmarks (``wendel bench [NAME ...] [--quick]``): speed and cost figures written to results/bench/.
+
+A benchmark is a function registered with :func:`register` (module ``bench/<name>.py`` for
+``wendel bench <name>``); it returns a list of rows (dicts) that
+are written as ``results/bench/<name>.csv`` and ``.json`` together with the machine it ran on.
+Ratios are always taken within one benchmark run.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import os
+import platform
+import time
+from pathlib import Path
+from typing import Callable
+
+from ..loop import RESULTS
+
+BENCHES: dict[str, Callable[[bool, Path], list[dict]]] = {}
+OPT_IN = {"step42-dealii"}
+"""Run only when named: deal.II's step-42 needs extra Debian packages and 8 minutes."""
+
+
+def register(name: str):
+    """Register a benchmark ``func(quick, workdir) -> rows`` under ``name``."""
+
+    def wrap(func):
+        BENCHES[name] = func
+        return func
+
+    return wrap
+
+
+def bench(names: list[str] | None = None, quick: bool = False, out: Path | None = None, progress=print) -> Path:
+    """Run the named benchmarks (by default all but those of ``OPT_IN``); return the folder with their results."""
+    _load_plugins()
+    names = names or sorted(n for n in BENCHES if n not in OPT_IN)
+    unknown = [n for n in names if n not in BENCHES]
+    if unknown:
+        raise KeyError(f"unknown benchmark(s) {', '.join(unknown)}; valid: {', '.join(sorted(BENCHES))}")
+    root = Path(out) if out else RESULTS / "bench"
+    root.mkdir(parents=True, exist_ok=True)
+    for name in names:
+        progress(f"bench {name} ...")
+        t0 = time.perf_counter()
+        rows = BENCHES[name](quick, root / "work" / name)
+        meta = {"name": name, "quick": quick, "seconds": time.perf_counter() - t0, "cpus": os.cpu_count(),
+                "platform": platform.platform(), "date": time.strftime("%Y-%m-%dT%H:%M:%S%z")}
+        (root / f"{name}.json").write_text(json.dumps({"meta": meta, "rows": rows}, indent=1))
+        if rows:
+            keys = list(dict.fromkeys(k for r in rows for k in r))
+            with open(root / f"{name}.csv", "w", newline="") as f:
+                w = csv.DictWriter(f, fieldnames=keys)
+                w.writeheader()
+                w.writerows(rows)
+            progress(_table(rows))
+    return root
+
+
+def _table(rows: list[dict]) -> str:
+    keys = list(dict.fromkeys(k for r in rows for k in r))
+    fmt = lambda v: f"{v:.4g}" if isinstance(v, float) else str(v)
+    lines = ["| " + " | ".join(keys) + " |", "|" + "---|" * len(keys)]
+    lines += ["| " + " | ".join(fmt(r.get(k, "")) for k in keys) + " |" for r in rows]
+    return "\n".join(lines)
+
+
+def _load_plugins() -> None:
+    """Import every benchmark module of this package (``bench/<name>.py``; each registers itself)."""
+    import importlib
+    import pkgutil
+
+    for info in pkgutil.iter_modules(__path__):
+        importlib.import_module(f"{__name__}.{info.name}")
+
+
+WORKFLOWS = Path(__file__).resolve().parents[3] / "workflows"

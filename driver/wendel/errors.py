@@ -1,0 +1,33 @@
+"""The ways a run stops short, as exceptions the command line turns into exit codes and messages.
+
+Kept apart from the loop so that ``wendel check`` can name them without importing the solver side.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+
+class StepCutError(RuntimeError):
+    """An increment failed after every allowed step cut; accepted increments are on disk."""
+
+
+class Interrupted(KeyboardInterrupt):
+    """Ctrl-C or SIGTERM stopped the run in ``root``; FreeFEM was stopped too and the run can resume."""
+
+    def __init__(self, root: Path):
+        super().__init__(f"interrupted; resume with `wendel run --resume {root}`")
+        self.root = root
+
+
+class DiskFull(OSError):
+    """The disk of the run folder ``root`` is full; accepted increments are kept and the run can resume."""
+
+    def __init__(self, root: Path):
+        super().__init__(f"disk full under {root}: the accepted increments are kept; free some space and "
+                         f"resume with `wendel run --resume {root}`")
+        self.root = root
+
+
+class RunFolderError(ValueError):
+    """The run folder (``--out``) cannot be used."""

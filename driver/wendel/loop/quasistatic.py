@@ -1,0 +1,287 @@
+"""The quasi-static loop: build the mesh, step the load, cut steps that fail, write results, report.
+
+:func:`run` is the table of contents; each step is a small function below it. Step control is in
+:mod:`.steps`, the FreeFEM command of a scene in :mod:`.launch`, the checkpoint in :mod:`.checkpoint`,
+the progress lines in :mod:`.progress`, the remesh step in :mod:`wendel.remesh.step`.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import shutil
+import tempfile
+import time
+from pathlib import Path
+
+from .. import freefem
+from ..errors import DiskFull, RunFolderError
+from ..meshes import build as build_mesh
+from ..remesh.step import finish_report, judge, maybe_remesh
+from ..results import pictures, summary, vtu
+from ..scene import load
+from ..scene.reading import check_size
+from ..scene.schema import Scene
+from .checkpoint import RunFiles, State, committed, load_state, save as _save_checkpoint
+from .guard import disk_full as _disk_full, guarded
+from .launch import entry_script, macros, options, write_tables
+from .progress import _Progress
+from .steps import cut_step, grow_step, plan_step
+
+RESULTS = freefem.ROOT / "results"
+
+
+def run(scene_path: str | Path, smoke: bool = False, ranks: int | None = None, out: Path | None = None,
+        resume: Path | None = None, progress=print, png: bool | None = None, scale: float | None = None) -> Path:
+    """Run the scene file ``scene_path``; return the run folder (results/<scene>/<run-id>/).
+
+    ``ranks`` and ``png`` override numerics.ranks and output.png; ``scale`` multiplies
+    geometry.h and the size of a refined zone (geometry.refine.h); ``resume`` continues the run folder
+    given from its last checkpoint.
+    """
+    if resume is not None:
+        root = Path(resume).resolve()
+        if not (root / "checkpoint.json").is_file() and (root / "scene.resolved.json").is_file():
+            return _restart(root, progress)
+        with guarded(root):
+            files, scene, state = _resume(root, progress)
+            progress(f"resuming {files.root} after increment {state.last[0]} (load factor {state.last[1]:g})")
+            return _execute(scene, files, state, progress)
+    scene_path = Path(scene_path)
+    scene = load(scene_path, smoke=smoke)
+    if scale is not None:
+        scene.geometry.h *= scale
+        refine = (scene.geometry.model_extra or {}).get("refine")
+        if isinstance(refine, dict) and "h" in refine:
+            refine["h"] *= scale
+    if png is not None:
+        scene.output.png = png
+    if ranks is not None:
+        if ranks > 1:
+            scene.numerics.solver = "ffddm"      # first: the schema refuses other solvers on several ranks
+        scene.numerics.ranks = ranks
+    return run_scene(scene, scene_path, Path(out) if out else _new_run_dir(scene_path, smoke), smoke, progress)
+
+
+def run_scene(scene: Scene, scene_path: Path, out: Path, smoke: bool = False, progress=print) -> Path:
+    """Run an already validated scene (read from ``scene_path``) into the folder ``out``."""
+    files = RunFiles(Path(out).resolve())      # FreeFEM runs inside the run folder: paths must be absolute
+    if files.root.is_dir() and any(files.root.iterdir()):
+        # never mix a new run with the files of another (nor delete them): a new folder, or --resume
+        raise ValueError(f"run folder {files.root} exists and is not empty: choose another --out, or continue "
+                         f"the run in it with `wendel run --resume {files.root}`")
+    if files.root.exists() and not files.root.is_dir():
+        raise RunFolderError(f"run folder (--out) {out}: is a file, not a folder")
+    try:
+        files.root.mkdir(parents=True, exist_ok=True)
+        (files.root / ".write-test").touch()
+        (files.root / ".write-test").unlink()
+    except OSError as exc:
+        raise RunFolderError(f"run folder (--out) {out}: cannot be created or written: {exc.strerror}") from None
+    check_size(scene, str(scene_path))       # h may have been scaled since the scene was read (studies)
+    with guarded(files.root):
+        summary.write_provenance(files.root, Path(scene_path), scene, smoke)
+        state = State(pending=scene.loading.load_factors())
+        state.mesh_seconds, dimension = build(scene, files)
+        _save_checkpoint(files, scene, state, dimension)
+        return _execute(scene, files, state, progress)
+
+
+def _execute(scene: Scene, files: RunFiles, state: State, progress) -> Path:
+    """Solve the pending increments, then summary and picture."""
+    dimension = json.loads(files.checkpoint.read_text())["dimension"]
+    progress(f"wendel: {scene.description}")
+    progress(f"  run folder {files.root}")
+    try:
+        segment = state.segments[-1]
+        after_reequilibration = len(state.segments) > 1 and state.last[0] == segment["first"]
+        if scene.remesh and state.accepted and state.pending and not state.reequilibrate \
+                and not after_reequilibration:
+            maybe_remesh(scene, files, state, dimension, progress)    # a run resumed before the decision
+        solve(scene, files, state, dimension, progress)
+    finally:
+        with contextlib.suppress(OSError):       # a full disk must not hide why the run stopped
+            summary.write_summary(files.root, scene, state, dimension)
+    if scene.output.png and state.accepted:
+        t0 = time.perf_counter()
+        inc, lf = state.last
+        if scene.output.vtu:
+            pictures.picture(files.vtu / f"inc-{inc:04d}.vtu", files.root / "deformed.png", f"load factor {lf:g}",
+                             scene.output.warp)
+        else:            # no VTU series: the picture is made from a VTU of the last increment that is not kept
+            with tempfile.TemporaryDirectory() as tmp:
+                _write_increment_vtu(files, state, dimension, inc, Path(tmp) / "last.vtu")
+                pictures.picture(Path(tmp) / "last.vtu", files.root / "deformed.png", f"load factor {lf:g}",
+                                 scene.output.warp)
+        state.post_seconds += time.perf_counter() - t0
+        summary.write_summary(files.root, scene, state, dimension)
+    return files.root
+
+
+def _write_increment_vtu(files: RunFiles, state: State, dimension: int, inc: int, path: Path) -> None:
+    """The VTU of accepted increment ``inc`` at ``path``."""
+    points, cells = vtu.read_mesh(files.root / state.segment(inc)["mesh"], dimension)
+    pdata, cdata = vtu.increment_fields(files.fem / f"inc-{inc:04d}", len(points), len(cells), dimension)
+    vtu.write_vtu(path, points, cells, dimension, pdata, cdata)
+
+
+def build(scene: Scene, files: RunFiles) -> tuple[float, int]:
+    """Make the mesh (gmsh builder or a given file); return (seconds, dimension)."""
+    t0 = time.perf_counter()
+    g = scene.geometry
+    if g.builder:
+        built = build_mesh(g.builder, files.mesh, **g.params)
+        dimension = built.dimension
+    else:
+        shutil.copyfile(g.mesh, files.mesh)
+        dimension = g.dimension
+    return time.perf_counter() - t0, dimension
+
+
+def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress) -> None:
+    """Launch FreeFEM on the pending increments; cut failing steps; remesh when the mesh distorts.
+
+    Without remeshing one launch runs all pending increments (start-up paid once); with remeshing each
+    launch runs one increment so that the driver judges the mesh after every increment.
+    """
+    write_tables(scene, files, dimension)
+    entry = entry_script(scene, dimension)
+    switches = macros(scene, dimension)
+    while state.pending:
+        inc0 = state.last[0] + 1
+        if scene.loading.adaptive and not state.reequilibrate:
+            plan_step(scene, state)
+        one_by_one = scene.remesh is not None or scene.loading.adaptive
+        batch = state.pending[:1] if one_by_one else list(state.pending)
+        loads = files.tables / "loads.txt"
+        loads.write_text(f"{len(batch)}\n" + "".join(f"{lf!r}\n" for lf in batch))
+        seg = state.segment(inc0)
+        opts = options(scene, files, dimension, seg) + ["-loads", str(loads), "-inc0", str(inc0)]
+        if state.reequilibrate:
+            opts += ["-restart", str(files.root / seg["state"])]
+        elif state.accepted:
+            opts += ["-restart", str(files.fem / f"inc-{state.last[0]:04d}")]
+        watcher = _Progress(files.fem, inc0, len(batch), batch, progress)
+        failure, before, t0 = None, len(state.accepted), time.perf_counter()
+        try:
+            with watcher:
+                freefem.run(entry, switches + opts, files.fem, ranks=scene.numerics.ranks,
+                            timeout=scene.numerics.timeout, log=files.root / "freefem.log")
+        except freefem.NewtonFailure as exc:
+            failure = exc
+        finally:
+            accept(scene, files, state, dimension)
+            state.launches.append({"wall": time.perf_counter() - t0, "increments": len(state.accepted) - before,
+                                   "complete": failure is None})
+        if failure is None and len(state.accepted) - before < len(batch):
+            if _disk_full(files.root):
+                raise DiskFull(files.root)
+            raise freefem.FreeFemError(f"FreeFEM ended without committing increment {state.last[0] + 1} whole "
+                                       f"(see {files.fem / f'inc-{state.last[0] + 1:04d}'})")
+        if failure is not None:
+            cut_step(scene, files, state, failure, progress)
+            _save_checkpoint(files, scene, state, dimension)
+            continue
+        if scene.loading.adaptive and not state.reequilibrate:
+            grow_step(scene, state, files)
+        if state.reequilibrate:
+            _reequilibrated(files, state, progress)
+        elif scene.remesh and state.pending:
+            maybe_remesh(scene, files, state, dimension, progress)
+        _save_checkpoint(files, scene, state, dimension)
+
+
+def _reequilibrated(files: RunFiles, state: State, progress) -> None:
+    """The increment on a new mesh is accepted: the remesh is complete (its report gets the residuals)."""
+    state.reequilibrate = False
+    rep = state.remeshes[-1]
+    finish_report(rep, files.fem / f"inc-{state.last[0]:04d}",
+                  files.root / "remesh" / f"remesh-{len(state.remeshes)}.json")
+    progress(f"  re-equilibrated on the new mesh: relative residual {rep['residual_after_transfer']:.2e}"
+             f" -> {rep['residual_after_reequilibration']:.2e}")
+
+
+def accept(scene: Scene, files: RunFiles, state: State, dimension: int) -> None:
+    """Take the committed increments FreeFEM wrote: VTU, mesh quality, histories, checkpoint."""
+    t0 = time.perf_counter()
+    meshes: dict[str, tuple] = {}
+    while state.pending:
+        inc = state.last[0] + 1
+        d = files.fem / f"inc-{inc:04d}"
+        record = committed(d)
+        if record is None:
+            break
+        seg = state.segment(inc)
+        if seg["mesh"] not in meshes:
+            points, cells = vtu.read_mesh(files.root / seg["mesh"], dimension)
+            if seg["first"] == inc:
+                vtu.check_node_order(files.fem / "vertices.txt", points)
+            meshes[seg["mesh"]] = (points, cells)
+        points, cells = meshes[seg["mesh"]]
+        extra = {"reequilibration": int(state.reequilibrate and inc == seg["first"] and inc > 1)}
+        if scene.problem == "mechanics":
+            extra.update(judge(points, cells, vtu.read_array(d / "u.node.txt"), dimension))
+            state.quality[inc] = extra
+            if extra.get("inverted", 0) > 0 and scene.remesh is None:
+                print(f"  warning: increment {inc}: {extra['inverted']} inverted elements in the deformed mesh "
+                      f"(no [remesh] table); see summary.json warnings")
+        if scene.output.vtu:
+            pdata, cdata = vtu.increment_fields(d, len(points), len(cells), dimension)
+            files.vtu.mkdir(exist_ok=True)
+            vtu.write_vtu(files.vtu / f"inc-{inc:04d}.vtu", points, cells, dimension, pdata, cdata)
+        state.accepted.append((inc, record["load_factor"]))
+        state.pending.pop(0)
+        summary.append_history(files.root, {**record, **extra}, d / "newton.csv")
+        _save_checkpoint(files, scene, state, dimension)
+    if scene.output.vtu and state.accepted:
+        vtu.write_pvd(files.root / "results.pvd",
+                         [(lf, f"vtu/inc-{i:04d}.vtu") for i, lf in state.accepted])
+    state.post_seconds += time.perf_counter() - t0
+
+
+def _new_run_dir(scene_path: Path, smoke: bool) -> Path:
+    stamp = time.strftime("%Y%m%d-%H%M%S")
+    base = RESULTS / scene_path.stem / (stamp + ("-smoke" if smoke else ""))
+    d, k = base, 1
+    while True:                        # created here, atomically: parallel runs of a sweep get their own
+        try:
+            d.mkdir(parents=True)
+            return d
+        except FileExistsError:
+            k += 1
+            d = base.with_name(f"{base.name}-{k}")
+
+
+def _restart(root: Path, progress) -> Path:
+    """A run stopped before its first checkpoint (while meshing): nothing was computed, so it starts again
+    in its own folder from the scene it saved there."""
+    scene = Scene.model_validate(json.loads((root / "scene.resolved.json").read_text()))
+    smoke = False
+    with contextlib.suppress(OSError, ValueError, KeyError):
+        smoke = bool(json.loads((root / "provenance.json").read_text())["smoke"])
+    progress(f"resuming {root}: it stopped before its first increment; starting it again")
+    with tempfile.TemporaryDirectory() as tmp:
+        source = Path(tmp) / "scene.toml"
+        if (root / "scene.toml").is_file():
+            shutil.copyfile(root / "scene.toml", source)
+        else:
+            source.write_text("# the scene file was not saved before the run stopped; see scene.resolved.json\n")
+        for p in root.iterdir():
+            shutil.rmtree(p) if p.is_dir() else p.unlink()
+        return run_scene(scene, source, root, smoke, progress)
+
+
+def _resume(root: Path, progress=print) -> tuple[RunFiles, Scene, State]:
+    files, scene, state, dimension = load_state(root)
+    # An increment committed after the last checkpoint is taken as it is; a partial one is dropped.
+    summary.truncate_history(files.root, state.last[0])
+    accept(scene, files, state, dimension)
+    if state.reequilibrate and state.accepted and state.last[0] >= state.segments[-1]["first"]:
+        _reequilibrated(files, state, progress)      # stopped after the re-equilibration was committed
+        _save_checkpoint(files, scene, state, dimension)
+    nxt = files.fem / f"inc-{state.last[0] + 1:04d}"
+    if nxt.is_dir():
+        shutil.rmtree(nxt)
+    return files, scene, state
+
+

@@ -1,0 +1,66 @@
+"""Step control of the quasi-static loop: adaptive load steps (plan, grow) and halving a step that failed."""
+
+from __future__ import annotations
+
+import json
+import shutil
+
+from .. import freefem
+from ..errors import StepCutError
+from ..scene.schema import Scene
+from .checkpoint import RunFiles, State
+
+
+def plan_step(scene: Scene, state: State) -> None:
+    """Adaptive loading: put the next load factor (last + step, never past the next target) first."""
+    loading = scene.loading
+    if state.step is None:
+        state.step = loading.nominal_step()
+    target, last = state.pending[0], state.last[1]
+    direction = 1.0 if target >= last else -1.0
+    nxt = last + direction * state.step
+    if (nxt - target) * direction < -1e-12 * max(1.0, abs(target)):
+        state.pending.insert(0, nxt)
+
+
+def grow_step(scene: Scene, state: State, files: RunFiles) -> None:
+    """Adaptive loading: after an easy increment the step grows (up to loading.max_step)."""
+    loading = scene.loading
+    rec = json.loads((files.fem / f"inc-{state.last[0]:04d}" / "record.json").read_text())
+    if rec["newton_iterations"] <= loading.easy_iterations:
+        state.step = min(state.step * loading.grow, loading.max_step or loading.nominal_step())
+
+
+def cut_step(scene: Scene, files: RunFiles, state: State, failure: freefem.NewtonFailure, progress) -> None:
+    """Halve the failed increment, or stop with a clear message when no cut is left."""
+    rec = failure.record
+    inc = state.last[0] + 1
+    failed = files.fem / f"inc-{inc:04d}"
+    if failed.is_dir():
+        keep = files.root / "failed-attempts"
+        keep.mkdir(exist_ok=True)
+        if (failed / "newton.csv").is_file():
+            shutil.copyfile(failed / "newton.csv", keep / f"inc-{inc:04d}-lf-{rec['load_factor']:.6g}-newton.csv")
+        shutil.rmtree(failed)
+    reason = rec.get("reason", "Newton did not converge")
+    lf_prev, lf_fail = state.last[1], state.pending[0]
+    state.cuts += 1
+    mid = lf_prev + 0.5 * (lf_fail - lf_prev)
+    smallest = scene.loading.nominal_step() / 2 ** scene.loading.max_cuts
+    if reason == "limit load reached" or abs(mid - lf_prev) < smallest * (1 - 1e-9):
+        what = "limit load reached" if reason == "limit load reached" else \
+            f"{reason}, even after {scene.loading.max_cuts} step halvings (loading.max_cuts)"
+        # the bracket of the limit (or of the failure): summary.json reports it
+        (files.root / "stopped.json").write_text(json.dumps(
+            {"increment": inc, "reason": what, "last_converged_load_factor": lf_prev,
+             "first_failed_load_factor": lf_fail}, indent=1))
+        raise StepCutError(
+            f"increment {inc} (load factor {lf_prev:g} -> {lf_fail:g}): {what} between load factor {lf_prev:g} "
+            f"(last converged) and {lf_fail:g} (first failed); "
+            f"{len(state.accepted)} accepted increments are kept in {files.root}")
+    if scene.loading.adaptive:
+        state.step = abs(mid - lf_prev)
+        if all(abs(lf_fail - t) > 1e-12 * max(1.0, abs(t)) for t in scene.loading.load_factors()):
+            state.pending.pop(0)         # an intermediate point of the adaptive loading: plan_step re-plans
+    state.pending.insert(0, mid)
+    progress(f"  increment {inc}: {reason} at load factor {lf_fail:g}; cutting the step to {mid:g}")

@@ -1,0 +1,190 @@
+"""Provenance, histories and summary.json of a run.
+
+summary.json holds the fingerprints of the last increment (DoFs, Newton iterations, errors, physical
+quantities) and the wall time by phase: mesh (gmsh), FreeFEM start-up (launch wall time minus
+FreeFEM's own clock), assembly, linear solve, constitutive update, FreeFEM output, driver
+post-processing (VTU, PNG).
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import os
+import platform
+import shutil
+import socket
+import subprocess
+import sys
+import time
+from importlib import metadata
+from pathlib import Path
+
+from .. import __version__
+
+ROOT = Path(__file__).resolve().parents[3]
+
+
+def _git_commit() -> str:
+    try:
+        out = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "HEAD"], capture_output=True, text=True, timeout=5)
+        dirty = subprocess.run(["git", "-C", str(ROOT), "status", "--porcelain", "--untracked-files=no"],
+                               capture_output=True, text=True, timeout=5).stdout.strip()
+        return out.stdout.strip() + ("+dirty" if dirty else "")
+    except (OSError, subprocess.SubprocessError):
+        return "unknown"
+
+
+def _freefem_version() -> str:
+    try:
+        out = subprocess.run(["dpkg-query", "-W", "-f=${Version}", "freefem++"], capture_output=True, text=True, timeout=5)
+        return out.stdout.strip() or "unknown"
+    except (OSError, subprocess.SubprocessError):
+        return "unknown"
+
+
+def write_provenance(root: Path, scene_path: Path, scene, smoke: bool) -> None:
+    """The scene as run and where it ran: commit, versions, command line, host, start time."""
+    # first and atomically: a run stopped before its first checkpoint restarts from it (wendel run --resume)
+    tmp = root / "scene.resolved.json.tmp"
+    tmp.write_text(json.dumps(scene.model_dump(mode="json"), indent=1))
+    os.replace(tmp, root / "scene.resolved.json")
+    shutil.copyfile(scene_path, root / "scene.toml")
+    versions = {"wendel": __version__, "python": sys.version.split()[0], "freefem++": _freefem_version()}
+    for pkg in ("gmsh", "meshio", "numpy", "scipy", "pydantic", "pyvista", "matplotlib"):
+        try:
+            versions[pkg] = metadata.version(pkg)
+        except metadata.PackageNotFoundError:
+            versions[pkg] = "missing"
+    prov = {"git_commit": _git_commit(), "versions": versions, "command": sys.argv, "smoke": smoke,
+            "host": socket.gethostname(), "platform": platform.platform(), "cpus": os.cpu_count(),
+            "start": time.strftime("%Y-%m-%dT%H:%M:%S%z")}
+    (root / "provenance.json").write_text(json.dumps(prov, indent=1))
+
+
+def append_history(root: Path, record: dict, newton_csv: Path) -> None:
+    """One row per accepted increment in history.csv; its Newton rows appended to newton.csv."""
+    hist = root / "history.csv"
+    keys = [k for k, v in record.items() if isinstance(v, (int, float))]
+    new = not hist.exists()
+    with open(hist, "a", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=keys, extrasaction="ignore")
+        if new:
+            w.writeheader()
+        w.writerow(record)
+    rows = newton_csv.read_text().splitlines() if newton_csv.is_file() else []
+    all_newton = root / "newton.csv"
+    if rows:
+        header = not all_newton.exists()
+        with open(all_newton, "a") as f:
+            f.write("\n".join(rows if header else rows[1:]) + "\n")
+
+
+def truncate_history(root: Path, last_increment: int) -> None:
+    """Drop history and Newton rows past ``last_increment`` (a resumed run writes them again)."""
+    for name in ("history.csv", "newton.csv"):
+        path = root / name
+        if not path.is_file():
+            continue
+        lines = path.read_text().splitlines()
+        width = len(lines[0].split(",")) if lines else 0
+        # a row cut short by a crash or a full disk has fewer fields than the header: dropped
+        keep = lines[:1] + [l for l in lines[1:] if len(l.split(",")) == width
+                            and int(float(l.split(",", 1)[0])) <= last_increment]
+        tmp = path.with_suffix(".tmp")
+        tmp.write_text("\n".join(keep) + "\n")
+        os.replace(tmp, path)
+
+
+def read_records(root: Path) -> list[dict]:
+    """record.json of every accepted increment, in order."""
+    return [json.loads((d / "record.json").read_text())
+            for d in sorted((root / "fem").glob("inc-*")) if (d / "done").is_file()]
+
+
+def write_summary(root: Path, scene, state, dimension: int) -> dict:
+    """summary.json: fingerprints of the last increment and wall time by phase."""
+    records = read_records(root)
+    phases = {"mesh": state.mesh_seconds, "freefem_startup": 0.0, "assembly": 0.0, "linear_solve": 0.0,
+              "constitutive": 0.0, "freefem_output": 0.0, "freefem_other": 0.0,
+              "driver_output": state.post_seconds}
+    # FreeFEM's clocks are cumulative within a launch: take the last record of each launch.
+    by_launch, idx = [], 0
+    for launch in state.launches:
+        n = launch["increments"]
+        chunk = records[idx: idx + n] if n else []
+        idx += len(chunk)
+        by_launch.append((launch, chunk[-1] if chunk else None))
+    for launch, rec in by_launch:
+        if rec is None:
+            continue
+        inner = rec["time_total"]
+        phases["freefem_startup"] += max(launch["wall"] - inner, 0.0)
+        phases["assembly"] += rec["time_assembly"]
+        phases["linear_solve"] += rec["time_solve"]
+        phases["constitutive"] += rec["time_constitutive"]
+        phases["freefem_output"] += rec["time_output"]
+        phases["freefem_other"] += inner - rec["time_assembly"] - rec["time_solve"] - rec["time_constitutive"] - rec["time_output"]
+    failed_wall = sum(l["wall"] for l, r in by_launch if r is None)
+    phases["failed_launches"] = failed_wall
+    total = sum(phases.values())
+    last = records[-1] if records else {}
+    summary = {
+        "scene": scene.description,
+        "dimension": dimension,
+        "blocks": scene.blocks,
+        "increments": len(state.accepted),
+        "pending_increments": len(state.pending),
+        "completed": not state.pending,
+        "step_cuts": state.cuts,
+        "launches": len(state.launches),
+        "newton_iterations": sum(r["newton_iterations"] for r in records),
+        "dofs": last.get("dofs"),
+        "elements": last.get("elements"),
+        "ranks": last.get("ranks"),
+        "solver": last.get("solver"),
+        "wall_time": total,
+        "wall_time_by_phase": phases,
+        "share_startup_and_io": (phases["freefem_startup"] + phases["freefem_output"] + phases["driver_output"]) / total
+        if total else None,
+        "remeshes": state.remeshes,
+        "errors": _errors(last),
+        "warnings": warnings(state, scene),
+        "last_increment": last,
+    }
+    if (root / "stopped.json").is_file():
+        summary["stopped"] = json.loads((root / "stopped.json").read_text())
+    prov_path = root / "provenance.json"
+    if prov_path.is_file():
+        prov = json.loads(prov_path.read_text())
+        prov["end"] = time.strftime("%Y-%m-%dT%H:%M:%S%z")
+        prov_path.write_text(json.dumps(prov, indent=1))
+    tmp = root / "summary.json.tmp"
+    tmp.write_text(json.dumps(summary, indent=1))
+    os.replace(tmp, root / "summary.json")
+    return summary
+
+
+def warnings(state, scene) -> list[str]:
+    """Silent trouble of accepted increments: inverted elements in a deformed mesh that was not remeshed."""
+    inverted = sorted(inc for inc, q in state.quality.items() if q.get("inverted", 0) > 0)
+    if not inverted:
+        return []
+    what = "no [remesh] table" if scene.remesh is None else "remeshing did not remove them"
+    return [f"increments {', '.join(map(str, inverted))}: the deformed mesh has inverted elements ({what}); "
+            f"results there are not trustworthy"]
+
+
+def _errors(last: dict) -> dict:
+    """The errors of the last increment: closed-form ones as computed (relative where the module makes them
+    so), the analytic L2 and H1 errors also relative to the reference field's norms.
+
+    >>> _errors({"error_l2": 0.5, "reference_l2": 2.0, "error_h1": -1, "error_p0": 0.01})
+    {'error_l2': 0.5, 'error_p0': 0.01, 'error_l2_relative': 0.25}
+    """
+    out = {k: v for k, v in last.items() if k.startswith("error_") and isinstance(v, (int, float)) and v >= 0}
+    for norm in ("l2", "h1"):
+        ref = last.get(f"reference_{norm}", -1)
+        if f"error_{norm}" in out and isinstance(ref, (int, float)) and ref > 0:
+            out[f"error_{norm}_relative"] = out[f"error_{norm}"] / ref
+    return out

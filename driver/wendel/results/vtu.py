@@ -1,0 +1,134 @@
+"""FreeFEM's field files to ParaView: one VTU per increment, a PVD index (pictures: :mod:`.pictures`).
+
+FreeFEM writes nodal fields (``name.node.txt``, P1 values in the node order of the mesh file,
+components interleaved) and cell fields (``name.cell.txt``); this module turns them into VTU with
+meshio, in float64, with 2D vectors padded to 3 components so ParaView can warp by them.
+"""
+
+from __future__ import annotations
+
+import os
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import meshio
+import numpy as np
+
+CELL_TYPES = {2: "triangle", 3: "tetra"}
+
+
+def read_array(path: Path) -> np.ndarray:
+    """Read edp's plain array format: the count, then the values (any whitespace)."""
+    with open(path) as f:
+        data = np.array(f.read().split(), dtype=float)
+    if data.size == 0:
+        raise ValueError(f"{path}: empty array file")
+    n = int(data[0])
+    if data.size - 1 != n:
+        raise ValueError(f"{path}: header says {n} values, found {data.size - 1}")
+    return data[1:]
+
+
+def complete_array(path: Path) -> bool:
+    r"""Whether the array file ``path`` holds all the values its count announces, i.e. it was not cut short
+    by a crash or a full disk.
+
+    FreeFEM writes ``n``, then rows of 5 values, the last one ending with a tab: checked by counting rows
+    and the last row's values (no parsing of the rest); another layout is parsed whole.
+
+    >>> import tempfile; p = Path(tempfile.mkdtemp()) / "a.txt"
+    >>> _ = p.write_text("7\t\n\t1\t2\t3\t4\t5\n\t6\t7\t")
+    >>> complete_array(p), (p.write_text("7\t\n\t1\t2\t3\t4\t5\n\t6\t7") and complete_array(p))
+    (True, False)
+    """
+    try:
+        data = path.read_bytes()
+        head, _, body = data.partition(b"\n")
+        n = int(head)
+        rows = -(-n // 5)
+        last = body[body.rfind(b"\n") + 1:]
+        if data.endswith(b"\t") and body.count(b"\n") == rows - 1 and len(last.split()) == n - 5 * (rows - 1):
+            return True
+        if data.endswith(b"\t") or b"\t" not in body:
+            return read_array(path).size == n         # another layout (one value per line): parse it
+        return False
+    except (OSError, ValueError):
+        return False
+
+
+def write_array(path: Path, values) -> None:
+    """Write edp's plain array format (count, then one value per line, full precision)."""
+    v = np.asarray(values, dtype=float).ravel()
+    with open(path, "w") as f:
+        f.write(f"{v.size}\n")
+        f.write("\n".join(map(repr, v.tolist())))     # shortest round-trip text, 5x faster than savetxt
+        f.write("\n")
+
+
+def read_mesh(path: Path, dimension: int) -> tuple[np.ndarray, np.ndarray]:
+    """Points (n, 3) and the cells of the given dimension of a gmsh file."""
+    m = meshio.read(path, file_format="gmsh")
+    cells = np.concatenate([b.data for b in m.cells if b.type == CELL_TYPES[dimension]])
+    return m.points, cells
+
+
+def read_vertices(vertices_txt: Path) -> np.ndarray:
+    """FreeFEM's vertex coordinates (n, 3) from ``vertices.txt`` (component-major: all x, all y, all z)."""
+    return read_array(vertices_txt).reshape(3, -1).T
+
+
+def check_node_order(vertices_txt: Path, points: np.ndarray) -> None:
+    """Fail loudly if FreeFEM's vertex order differs from the mesh file's node order."""
+    xyz = read_vertices(vertices_txt)
+    n = len(xyz)
+    if n != len(points) or not np.allclose(xyz, points[:, :3], rtol=0, atol=1e-9 * max(1.0, np.abs(points).max())):
+        raise RuntimeError(f"{vertices_txt}: FreeFEM's vertices do not match the nodes of the mesh file "
+                           f"({n} vs {len(points)}); the VTU would be wrong")
+
+
+def increment_fields(inc_dir: Path, n_points: int, n_cells: int, dimension: int):
+    """Point and cell data of one increment folder, shaped for meshio."""
+    point_data, cell_data = {}, {}
+    for f in sorted(inc_dir.glob("*.node.txt")):
+        name = f.name.removesuffix(".node.txt")
+        v = read_array(f)
+        if v.size % n_points:
+            raise ValueError(f"{f}: {v.size} values do not fit {n_points} nodes")
+        ncomp = v.size // n_points
+        v = v.reshape(n_points, ncomp) if ncomp > 1 else v
+        if ncomp == 2 and dimension == 2:
+            v = np.column_stack([v, np.zeros(n_points)])
+        point_data[name] = v
+    for f in sorted(inc_dir.glob("*.cell.txt")):
+        name = f.name.removesuffix(".cell.txt")
+        v = read_array(f)
+        if v.size % n_cells:
+            raise ValueError(f"{f}: {v.size} values do not fit {n_cells} cells")
+        ncomp = v.size // n_cells
+        cell_data[name] = [v.reshape(n_cells, ncomp) if ncomp > 1 else v]
+    return point_data, cell_data
+
+
+def write_vtu(path: Path, points, cells, dimension: int, point_data, cell_data) -> None:
+    """Write one VTU (atomic: written beside, then renamed)."""
+    mesh = meshio.Mesh(points, [(CELL_TYPES[dimension], cells)], point_data=point_data, cell_data=cell_data)
+    tmp = path.with_suffix(".tmp.vtu")
+    meshio.write(tmp, mesh, binary=True)
+    os.replace(tmp, path)
+
+
+def write_pvd(path: Path, entries: list[tuple[float, str]]) -> None:
+    """A ParaView collection: (time = load factor, relative VTU path) per increment."""
+    root = ET.Element("VTKFile", type="Collection", version="0.1", byte_order="LittleEndian")
+    coll = ET.SubElement(root, "Collection")
+    for t, f in entries:
+        ET.SubElement(coll, "DataSet", timestep=repr(float(t)), group="", part="0", file=f)
+    tmp = path.with_suffix(".tmp")
+    ET.ElementTree(root).write(tmp, xml_declaration=True, encoding="utf-8")
+    os.replace(tmp, path)
+
+
+def read_pvd(path: Path) -> list[tuple[float, Path]]:
+    """The (time, VTU path) entries of a PVD file."""
+    root = ET.parse(path).getroot()
+    return [(float(d.get("timestep")), path.parent / d.get("file")) for d in root.iter("DataSet")]

@@ -1,0 +1,347 @@
+"""The scene schema: every key once, with type, default, unit, range and help.
+
+Validation, ``wendel check``, the CLI help and the README's key table all come from these models.
+Lengths in m, stresses and moduli in Pa, forces per volume in N/m^3, times in s. One file (about 320
+lines) on purpose: the single source of truth of the keys; the optional blocks' tables are in
+:mod:`wendel.scene.blocks`.
+
+>>> Material(E=2.5, nu=0.25).nu
+0.25
+"""
+
+from __future__ import annotations
+
+import inspect
+import typing
+from typing import Literal, Optional
+
+from pydantic import BaseModel, ConfigDict, Field, create_model, field_validator, model_validator
+
+from .blocks import BLOCKS, PROBLEMS, choice, load_all
+from ..results.comparisons import COMPARISONS
+from ..meshes import BUILDERS
+from .petsc import PRECONDITIONERS, PcName, check_options
+
+# Names a scene may use, mapped to the integer ids of edp/lib/loads.idp (never code).
+BODY_FORCES = {"none": 0, "constant": 1, "step8-discs": 2, "manufactured": 3}
+ANALYTIC_REFERENCES = {"manufactured-sine": 1}
+SOLVERS = ("direct", "cg", "ffddm", "petsc")
+
+BodyForceName = choice(BODY_FORCES, "body force")
+SolverName = choice(SOLVERS, "solver")
+AnalyticName = choice(ANALYTIC_REFERENCES, "analytic reference")
+ComparisonName = choice(COMPARISONS, "comparison")
+
+
+class Strict(BaseModel):
+    """Base of every scene table: unknown keys are errors."""
+
+    model_config = ConfigDict(extra="forbid", validate_assignment=True)
+
+
+class Geometry(Strict):
+    """Where the mesh comes from: a builder of meshes/ with its parameters, or a mesh file."""
+
+    model_config = ConfigDict(extra="allow")
+    builder: Optional[str] = Field(None, description="gmsh builder of meshes/ (rectangle, box, ring, ...)")
+    mesh: Optional[str] = Field(None, description="MSH 2.2 file, relative to the scene file")
+    h: float = Field(0.1, gt=0, description="target element size [m]")
+    dimension: Optional[int] = Field(None, description="2 or 3; needed only with `mesh`")
+
+    @model_validator(mode="after")
+    def _source(self):
+        if (self.builder is None) == (self.mesh is None):
+            raise ValueError("give exactly one of `builder` or `mesh`")
+        if self.builder is not None:
+            if self.builder not in BUILDERS:
+                raise ValueError(f"unknown builder {self.builder!r}; valid: {', '.join(sorted(BUILDERS))}")
+            allowed = set(inspect.signature(BUILDERS[self.builder]).parameters) - {"path", "h"}
+            unknown = set(self.model_extra or {}) - allowed
+            if unknown:
+                raise ValueError(
+                    f"unknown key(s) {', '.join(sorted(unknown))} for builder {self.builder!r}; "
+                    f"valid: h, {', '.join(sorted(allowed))}")
+        elif self.model_extra:
+            raise ValueError(f"unknown key(s) {', '.join(sorted(self.model_extra))} next to `mesh`")
+        elif self.dimension not in (2, 3):
+            raise ValueError("a `mesh` file needs `dimension = 2` or `3`")
+        return self
+
+    @property
+    def params(self) -> dict:
+        """Builder parameters (everything but builder/mesh/dimension)."""
+        return {"h": self.h, **(self.model_extra or {})}
+
+
+class Material(Strict):
+    """Isotropic elastic constants."""
+
+    E: float = Field(..., gt=0, description="Young's modulus [Pa]")
+    nu: float = Field(..., gt=-1, lt=0.5, description="Poisson's ratio [1], in (-1, 0.5)")
+
+
+class Elasticity(Strict):
+    """Options of the elastic part (present in every mechanical scene)."""
+
+    plane: Literal["strain", "stress"] = Field("strain", description="2D hypothesis")
+
+
+class Boundary(Strict):
+    """Conditions on one named boundary; each displacement component is optional (free if absent)."""
+
+    ux: Optional[float] = Field(None, description="prescribed x displacement at load factor 1 [m]")
+    uy: Optional[float] = Field(None, description="prescribed y displacement at load factor 1 [m]")
+    uz: Optional[float] = Field(None, description="prescribed z displacement at load factor 1 [m]")
+    traction: Optional[list[float]] = Field(None, description="traction vector at load factor 1 [Pa]")
+    pressure: Optional[float] = Field(None, description="normal pressure at load factor 1 [Pa]")
+
+    @field_validator("traction")
+    @classmethod
+    def _traction(cls, v):
+        if v is not None and len(v) not in (2, 3):
+            raise ValueError("traction has 2 (2D) or 3 (3D) components")
+        return v
+
+
+class BodyForce(Strict):
+    """A named body force (edp/lib/loads.idp)."""
+
+    kind: BodyForceName = Field("none", description=f"one of {', '.join(BODY_FORCES)}")
+    value: list[float] = Field([0.0, 0.0, 0.0], description="vector or magnitude(s) at load factor 1 [N/m^3]")
+
+
+
+class Loading(Strict):
+    """The load path: increments of the load factor from 0 to `final`."""
+
+    steps: int = Field(1, ge=1, description="number of equal increments")
+    final: float = Field(1.0, description="final load factor [1]")
+    factors: Optional[list[float]] = Field(None, description="explicit load factors (replaces steps/final)")
+    max_cuts: int = Field(6, ge=0, le=30, description="step halvings allowed per increment")
+    adaptive: bool = Field(False, description="grow the step after easy increments (one increment per launch); "
+                           "the load factors above are still all reached and written")
+    grow: float = Field(1.5, gt=1, le=4, description="step growth after an easy increment [1]")
+    easy_iterations: int = Field(4, ge=1, description="Newton iterations at or below which an increment is easy")
+    max_step: Optional[float] = Field(None, gt=0, description="largest load-factor step [1]; default the nominal step")
+
+    def load_factors(self) -> list[float]:
+        """The target load factors in order."""
+        if self.factors:
+            return [float(f) for f in self.factors]
+        return [self.final * (i + 1) / self.steps for i in range(self.steps)]
+
+    def nominal_step(self) -> float:
+        """The smallest step between successive target load factors."""
+        t = self.load_factors()
+        return min(abs(b - a) for a, b in zip([0.0] + t[:-1], t)) or 1.0
+
+
+class Petsc(Strict):
+    """The PETSc solver (numerics.solver = "petsc"): CG + a preconditioner preset, PETSc options on top."""
+
+    pc: PcName = Field("ml", description=f"preconditioner: {', '.join(PRECONDITIONERS)}")
+    options: str = Field("", description="more PETSc options, \"-name value\" pairs (e.g. \"-ksp_rtol 1e-8\"); "
+                         "they override the preset; no option that reads or writes files")
+    reuse: bool = Field(True, description="keep the preconditioner across Newton steps and increments while "
+                        "the iterations stay below 1.5x those right after its setup")
+
+    @field_validator("options")
+    @classmethod
+    def _options(cls, v):
+        return check_options(v)
+
+
+class Numerics(Strict):
+    """Solver settings."""
+
+    ranks: int = Field(1, ge=1, le=64, description="MPI ranks")
+    solver: SolverName = Field("direct", description=f"linear solver: {', '.join(SOLVERS)}")
+    solver_tol: float = Field(1e-10, gt=0, lt=1, description="relative residual of iterative solvers [1]")
+    newton_tol: float = Field(1e-9, gt=0, lt=1, description="relative Newton residual [1]")
+    newton_maxit: int = Field(25, ge=1, le=500, description="Newton iterations per increment")
+    timeout: float = Field(3600.0, gt=0, description="wall-time limit of one FreeFEM launch [s]")
+    petsc: Petsc = Field(default_factory=Petsc, description="PETSc solver settings (solver = \"petsc\")")
+    max_elements: float = Field(3e6, gt=0, description="refuse a mesh estimated above this many elements before "
+                                "meshing (about 1 GB per 300k 3D elements here; raise it on a bigger machine) [1]")
+    max_increments: int = Field(100000, ge=1, description="refuse a load path of more increments than this [1]")
+
+
+    @model_validator(mode="after")
+    def _ranks(self):
+        if self.ranks > 1 and self.solver not in ("ffddm", "petsc"):
+            raise ValueError(f"solver {self.solver!r} runs on one rank; use solver = \"ffddm\" or \"petsc\" "
+                             f"with ranks = {self.ranks}")
+        return self
+
+
+class Output(Strict):
+    """What a run writes besides summary.json and the histories."""
+
+    vtu: bool = Field(True, description="one VTU per increment and a PVD index")
+    png: bool = Field(True, description="picture of the deformed body at the last increment")
+    warp: float = Field(0.0, ge=0, description="displacement scale of the picture; 0 = automatic")
+
+
+class Remesh(Strict):
+    """Remeshing of the deformed body (its presence enables it): when the deformed mesh's quality falls
+    below the threshold, gmsh meshes the deformed configuration anew and the state is transferred."""
+
+    min_quality: float = Field(0.1, gt=0, lt=1, description="remesh when the min SICN of the deformed mesh falls below [1]")
+    h: Optional[float] = Field(None, gt=0, description="element size of the new meshes [m]; default geometry.h")
+    h_min: Optional[float] = Field(None, gt=0, description="smallest size where the indicator peaks [m]; default h/3")
+    indicator: str = Field("p", description="cell field that grades the size (e.g. p); empty: uniform size")
+    max_remeshes: int = Field(20, ge=0, description="remeshes allowed in one run")
+    at: list[int] = Field(default_factory=list, description="increments after which to remesh whatever the quality")
+
+
+class Reference(Strict):
+    """What errors are measured against: an analytic field, errors a module computes against a closed
+    form (record.json keys ``error_*``), or else the finest run of a study."""
+
+    analytic: Optional[AnalyticName] = Field(
+        None, description=f"analytic field: {', '.join(ANALYTIC_REFERENCES)}")
+    errors: list[str] = Field(default_factory=list,
+                              description="record.json keys of errors against closed forms, e.g. error_hertz_p0")
+    quantity: str = Field("strain_energy", description="record.json quantity compared with the finest run")
+    compare: Optional[ComparisonName] = Field(
+        None, description=f"another code's figures of the quantity, plotted by wendel study: {', '.join(COMPARISONS)}")
+
+
+    @field_validator("errors")
+    @classmethod
+    def _errors(cls, v):
+        bad = [k for k in v if not k.startswith("error_")]
+        if bad:
+            raise ValueError(f"error keys start with error_: {', '.join(bad)}")
+        return v
+
+
+class Smoke(Strict):
+    """The tiny size every scene declares (`wendel run --smoke`, CI): overrides of geometry and loading."""
+
+    model_config = ConfigDict(extra="forbid")
+    h: Optional[float] = Field(None, gt=0, description="element size of the smoke run [m]")
+    steps: Optional[int] = Field(None, ge=1, description="increments of the smoke run")
+    ranks: Optional[int] = Field(None, ge=1, description="MPI ranks of the smoke run")
+
+
+def _scene_model():
+    load_all()
+    extra = {name: (Optional[block.model], None) for name, block in BLOCKS.items()}
+    return create_model(
+        "Scene",
+        __base__=SceneBase,
+        **extra,
+    )
+
+
+class SceneBase(Strict):
+    """A scene: a one-line description, then geometry, material, physics, loading, numerics, output."""
+
+    description: str = Field(..., min_length=1, description="one line saying what is simulated")
+    problem: str = Field("mechanics", description="mechanics (default) or a registered scalar problem")
+    geometry: Geometry
+    material: Optional[Material] = Field(None, description="required by mechanics")
+    elasticity: Elasticity = Elasticity()
+    boundary: dict[str, Boundary] = Field(default_factory=dict, description="conditions by boundary name")
+    body_force: BodyForce = BodyForce()
+    loading: Loading = Loading()
+    numerics: Numerics = Numerics()
+    output: Output = Output()
+    remesh: Optional[Remesh] = Field(None, description="present: remesh the deformed body when it distorts")
+    reference: Reference = Reference()
+    smoke: Smoke = Smoke()
+
+    @model_validator(mode="after")
+    def _consistency(self):
+        if self.problem == "mechanics":
+            if self.material is None:
+                raise ValueError("material: Field required (problem = \"mechanics\", the default, needs it; "
+                                 "a scalar problem is named by `problem`)")
+            foreign = [n for n, b in BLOCKS.items() if not b.mechanics and getattr(self, n, None) is not None]
+            if foreign:
+                raise ValueError(f"table(s) {', '.join(foreign)} belong to another problem; set `problem`")
+        elif self.problem not in PROBLEMS:
+            raise ValueError(f"unknown problem {self.problem!r}; valid: mechanics, {', '.join(sorted(PROBLEMS))}")
+        else:
+            allowed = set(PROBLEMS[self.problem].tables)
+            present = {name for name in BLOCKS if getattr(self, name, None) is not None}
+            present |= {t for t in ("material",) if getattr(self, t) is not None}
+            present |= {t for t in ("boundary",) if getattr(self, t)}
+            extra = sorted(present - allowed)
+            if extra:
+                raise ValueError(f"problem {self.problem!r} does not use the table(s) {', '.join(extra)}")
+        for name, block in BLOCKS.items():
+            if block.check is not None and getattr(self, name, None) is not None:
+                block.check(getattr(self, name), self)
+        if self.body_force.kind == "manufactured" and self.reference.analytic is None:
+            raise ValueError("body_force.kind = \"manufactured\" needs reference.analytic")
+        return self
+
+    @property
+    def blocks(self) -> list[str]:
+        """Names of the optional physics blocks present, in entry-script order (mechanics only)."""
+        if self.problem != "mechanics":
+            return []
+        return sorted(n for n, b in BLOCKS.items() if b.mechanics and getattr(self, n, None) is not None)
+
+
+Scene = _scene_model()
+
+
+def _describe(model: type[BaseModel], prefix: str) -> list[tuple[str, str, str, str]]:
+    rows = []
+    for name, f in model.model_fields.items():
+        ann = f.annotation
+        if isinstance(ann, type) and issubclass(ann, BaseModel):
+            rows += _describe(ann, f"{prefix}{name}.")
+            continue
+        args = getattr(ann, "__args__", ())
+        sub = [a for a in args if isinstance(a, type) and issubclass(a, BaseModel)]
+        if sub:   # an optional table, or a dict of tables such as boundary.<name>
+            named = typing.get_origin(ann) is dict
+            rows += _describe(sub[0], f"{prefix}{name}.{'<name>.' if named else ''}")
+            continue
+        rng = ", ".join(f"{type(m).__name__.lower()} {getattr(m, type(m).__name__.lower(), '')}"
+                        for m in f.metadata if type(m).__name__ in ("Gt", "Ge", "Lt", "Le"))
+        inner = [typing.get_args(a)[0] if typing.get_origin(a) is typing.Annotated else a
+                 for a in args if a is not type(None)]
+        if getattr(ann, "__name__", "") == "Literal" or str(ann).startswith("typing.Literal"):
+            typ = " \\| ".join(repr(a) for a in args)
+        elif type(None) in args and inner:
+            typ = getattr(inner[0], "__name__", str(inner[0])) + ", optional"
+        elif typing.get_origin(ann) is typing.Union:
+            typ = " or ".join(getattr(a, "__name__", str(a)) for a in inner)
+        else:
+            typ = getattr(ann, "__name__", str(ann))
+        default = "required" if f.is_required() else repr(f.default) if f.default_factory is None else "{}"
+        rows.append((prefix + name, typ, default, (f.description or "") + (f" ({rng})" if rng else "")))
+    return rows
+
+
+KEYS_BEGIN, KEYS_END = "<!-- scene keys: begin (wendel keys --update README.md) -->", "<!-- scene keys: end -->"
+
+
+def update_readme(path) -> bool:
+    """Replace the key table between the markers of ``path``; return whether it changed."""
+    from pathlib import Path
+
+    text = Path(path).read_text()
+    head, rest = text.split(KEYS_BEGIN, 1)
+    _, tail = rest.split(KEYS_END, 1)
+    new = f"{head}{KEYS_BEGIN}\n{keys_table()}\n{KEYS_END}{tail}"
+    if new != text:
+        Path(path).write_text(new)
+    return new != text
+
+
+def keys_table() -> str:
+    """The scene keys as a Markdown table (the README's table is this text; a test keeps them equal)."""
+    from ..meshes.params import keyword_rows
+
+    rows = _describe(Scene, "")
+    at = next(i for i, r in enumerate(rows) if r[0].startswith("geometry.")) + 1
+    rows[at:at] = keyword_rows()      # the builders' keywords after geometry.builder
+    lines = ["| key | type | default | meaning |", "|---|---|---|---|"]
+    lines += [f"| `{k}` | {t} | {d} | {m} |" for k, t, d, m in rows]
+    return "\n".join(lines)

@@ -1,0 +1,160 @@
+"""Interruptions: kill -9 at many points of a remeshing run, Ctrl-C, SIGTERM and a full disk each resume to
+the result of the uninterrupted run (same increments, Newton iterations, remeshes and fields).
+
+The scene is ``upsetting`` at smoke size: 8 increments with three remeshes and re-equilibrations.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from conftest import WORKFLOWS
+
+SCENE = WORKFLOWS / "upsetting.toml"
+FIELDS = ("strain_energy", "max_plastic_strain", "max_displacement", "max_von_mises", "plastic_volume")
+
+
+def _start(*args: str) -> subprocess.Popen:
+    return subprocess.Popen([sys.executable, "-m", "wendel.cli", "run", *args], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+
+
+def fingerprints(run: Path) -> dict:
+    """What must not depend on interruptions: counts, and the physics of every accepted increment."""
+    s = json.loads((run / "summary.json").read_text())
+    rows = list(csv.DictReader((run / "history.csv").open()))
+    import meshio
+
+    last = sorted((run / "vtu").glob("inc-*.vtu"))[-1]
+    u = meshio.read(last).point_data["u_total"]
+    return {"increments": s["increments"], "completed": s["completed"], "newton": s["newton_iterations"],
+            "remeshes": len(s["remeshes"]), "dofs": s["dofs"],
+            "history": [[r["increment"], r["load_factor"], r["newton_iterations"]] + [float(r[f]) for f in FIELDS]
+                        for r in rows],
+            "u": u}
+
+
+def same(a: dict, b: dict) -> None:
+    assert {k: v for k, v in a.items() if k not in ("history", "u")} == \
+        {k: v for k, v in b.items() if k not in ("history", "u")}
+    assert len(a["history"]) == len(b["history"])
+    for ra, rb in zip(a["history"], b["history"]):
+        assert ra[:3] == rb[:3]
+        np.testing.assert_allclose(ra[3:], rb[3:], rtol=1e-9, atol=0)
+    np.testing.assert_allclose(a["u"], b["u"], rtol=1e-9, atol=1e-14)
+
+
+@pytest.fixture(scope="module")
+def reference(tmp_path_factory):
+    out = tmp_path_factory.mktemp("ref") / "run"
+    p = _start(str(SCENE), "--smoke", "--out", str(out))
+    assert p.wait(timeout=300) == 0, p.stderr.read()
+    return fingerprints(out)
+
+
+def _freefem_of(run: Path) -> list[int]:
+    out = subprocess.run(["pgrep", "-f", f"FreeFem.*{run}"], capture_output=True, text=True)
+    return [int(x) for x in out.stdout.split()]
+
+
+def _when(run: Path, event: str) -> bool:
+    ck = run / "checkpoint.json"
+    if event.startswith("committed-"):
+        return (run / "fem" / f"inc-{int(event.split('-')[1]):04d}" / "done").is_file()
+    if event == "started":          # the scene is saved, the first checkpoint not yet written
+        return (run / "scene.resolved.json").is_file()
+    if event == "meshing":
+        return (run / "meshes").is_dir() and any((run / "meshes").iterdir())
+    if event == "transfer":
+        return (run / "remesh").is_dir() and any((run / "remesh").glob("state-*"))
+    if event == "reequilibrating":
+        try:
+            return json.loads(ck.read_text()).get("reequilibrate", False)
+        except (OSError, ValueError):
+            return False
+    if event.startswith("after-"):
+        return time.monotonic() > float(event.split("-")[1])
+    raise ValueError(event)
+
+
+KILL_POINTS = ["started", "committed-1", "committed-2", "meshing", "transfer", "reequilibrating", "committed-4",
+               "committed-5", "after-2.5"]
+
+
+@pytest.mark.parametrize("event", KILL_POINTS)
+def test_kill9_resumes_to_the_same_result(event, tmp_path, reference):
+    run = tmp_path / "run"
+    p = _start(str(SCENE), "--smoke", "--out", str(run))
+    t0 = time.monotonic()
+    if event.startswith("after-"):
+        event = f"after-{t0 + float(event.split('-')[1])}"
+    while p.poll() is None and not _when(run, event):
+        time.sleep(0.005)
+    if p.poll() is not None:
+        pytest.fail(f"the run ended before {event}: {p.stderr.read()[-500:]}")
+    p.send_signal(signal.SIGKILL)
+    p.wait()
+    deadline = time.monotonic() + 10
+    while _freefem_of(run) and time.monotonic() < deadline:     # FreeFEM dies with its driver
+        time.sleep(0.1)
+    assert not _freefem_of(run), "FreeFEM outlived its driver"
+    if not (run / "scene.resolved.json").is_file():
+        # stopped before anything was saved (a slow start): nothing to resume, the same command starts again
+        r = _start("--resume", str(run))
+        _, err = r.communicate(timeout=60)
+        assert r.returncode == 2 and "start it again with `wendel run SCENE --out" in err, err
+        r = _start(str(SCENE), "--smoke", "--out", str(run))
+    else:
+        r = _start("--resume", str(run))
+    _, err = r.communicate(timeout=300)
+    assert r.returncode == 0, err
+    same(fingerprints(run), reference)
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+def test_interrupt_stops_freefem_and_resumes(sig, tmp_path, reference):
+    run = tmp_path / "run"
+    p = _start(str(SCENE), "--smoke", "--out", str(run))
+    while p.poll() is None and not _freefem_of(run):
+        time.sleep(0.01)
+    time.sleep(0.3)
+    p.send_signal(sig)
+    out, err = p.communicate(timeout=60)
+    assert p.returncode == 130, (p.returncode, err)
+    assert f"interrupted; resume with `wendel run --resume {run}`" in err, err
+    assert not _freefem_of(run), "FreeFEM runs on after the interrupt"
+    r = _start("--resume", str(run))
+    _, err = r.communicate(timeout=300)
+    assert r.returncode == 0, err
+    same(fingerprints(run), reference)
+
+
+@pytest.mark.skipif(os.geteuid() != 0, reason="mounting a small tmpfs needs root")
+def test_full_disk_stops_and_resumes(tmp_path, reference):
+    mnt = tmp_path / "small"
+    mnt.mkdir()
+    if subprocess.run(["mount", "-t", "tmpfs", "-o", "size=1200k", "tmpfs", str(mnt)]).returncode != 0:
+        pytest.skip("this machine does not allow mounting a tmpfs")
+    try:
+        run = mnt / "run"
+        p = _start(str(SCENE), "--smoke", "--out", str(run))
+        _, err = p.communicate(timeout=300)
+        assert p.returncode == 1, err
+        assert "disk full" in err and f"wendel run --resume {run}" in err, err
+        subprocess.run(["mount", "-o", "remount,size=64m", str(mnt)], check=True)
+        r = _start("--resume", str(run))
+        _, err = r.communicate(timeout=300)
+        assert r.returncode == 0, err
+        same(fingerprints(run), reference)
+    finally:
+        subprocess.run(["umount", "-l", str(mnt)])
