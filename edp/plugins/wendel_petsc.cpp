@@ -5,7 +5,9 @@
 //   long its = wendelPetscSolve(matrix K, real[int] b, real[int] x, real[int] fix, real[int] coords,
 //                               long bs, string options, real[int] info);
 //
-//   K        the Newton matrix, read only (FreeFEM owns it). Its coordinate triplets are sorted into CSR here.
+// Every array belongs to the FreeFEM script; the plugin reads K, b, fix, coords and writes (resizes) x and info.
+//
+//   K        the Newton matrix, read only. Its coordinate triplets are sorted into CSR here.
 //   b        right-hand side, read only: the rows with fix = 1 hold their prescribed values (already lifted
 //            into the free rows by the caller, lib/solver.idp).
 //   x        output, resized to K.n: the solution.
@@ -38,6 +40,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -80,11 +83,10 @@ PetscErrorCode destroyCache()
     PetscFunctionReturn(0);
 }
 
-void finalize()
+void finalize()                                // at FreeFEM's exit: nothing left to stop, so errors are only printed
 {
     if (!petscUp) return;
-    destroyCache();
-    PetscFinalize();
+    if (destroyCache() || PetscFinalize()) std::fprintf(stderr, "wendel_petsc: PETSc finalization failed\n");
     petscUp = false;
 }
 
@@ -351,9 +353,9 @@ long wendelPetscSolve(Matrice_Creuse<double>* const& K, KN<double>* const& b, KN
     PetscErrorCode ierr = solve(K, b, x, fix, coords, bs, *options, info);
     if (ierr) {
         const char* text = nullptr;
-        PetscErrorMessage(ierr, &text, NULL);
+        if (PetscErrorMessage(ierr, &text, NULL)) text = nullptr;
         // Drop the solver: the next call starts from a clean state.
-        destroyCache();
+        if (destroyCache()) std::fprintf(stderr, "wendel_petsc: could not free the cached solver\n");
         ExecError((std::string("wendelPetscSolve: PETSc error ") + std::to_string((int)ierr) + " ("
                    + (text ? text : "?") + "); see the PETSc message above").c_str());
     }
