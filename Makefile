@@ -7,6 +7,8 @@ VENV := .venv
 APT_PACKAGES := freefem++ libfreefem++-dev openmpi-bin libopenblas0-pthread g++ \
                 libegl1 libegl-mesa0 libgl1 libgl1-mesa-dri libglu1-mesa \
                 libpetsc-real3.18-dev
+# Test only: a single-node SLURM with accounting for the sweep tests (scripts/slurm-local.sh).
+APT_TEST_PACKAGES := slurmctld slurmd slurm-client slurmdbd munge mariadb-server
 SCENE ?= workflows/smoke.toml
 
 .PHONY: setup run test bench clean
@@ -48,7 +50,21 @@ build/plugins/wendel_petsc.so: edp/plugins/wendel_petsc.cpp build/.apt-ok
 run: setup
 	$(VENV)/bin/wendel run $(SCENE)
 
-test: setup
+# SLURM, munge and MariaDB for tests/test_sweep.py (their daemons are started by the test, not by apt).
+build/.apt-test-ok: Makefile
+	@mkdir -p build
+	@n_ok=$$(dpkg-query -W -f='$${Status}\n' $(APT_TEST_PACKAGES) 2>/dev/null | grep -c '^install ok installed$$'); \
+	if [ "$$n_ok" -eq "$(words $(APT_TEST_PACKAGES))" ]; then \
+	  echo "apt: test packages present"; \
+	else \
+	  echo "apt: installing $(APT_TEST_PACKAGES)"; \
+	  SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
+	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq --no-install-recommends $(APT_TEST_PACKAGES) \
+	    || echo "apt: test packages not installed: the SLURM tests will be skipped"; \
+	fi
+	@touch $@
+
+test: setup build/.apt-test-ok
 	$(VENV)/bin/python -m pytest -q
 
 bench: setup

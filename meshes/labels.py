@@ -16,8 +16,13 @@ LABELS = {
     "back": 6,      # y = y1 in 3D
     "inner": 7,     # inner surface of a hollow body
     "outer": 8,     # outer surface of a hollow body
+    "axis": 9,      # the axis r = 0 of an axisymmetric (r, z) section (u_r = 0 there, set by FreeFEM)
     "symmetry_x": 11,  # plane x = 0 of a symmetric model
     "symmetry_y": 12,  # plane y = 0 of a symmetric model
+    "free_surface": 21,  # orthogonal cutting: the uncut surface that becomes the chip's back
+    "machined": 22,      # orthogonal cutting: the machined surface behind the tool
+    "bore_wall": 23,   # cylindrical wall of a drilled bore (meshes/drilling.py)
+    "bore_bottom": 24,  # tip cone at the bottom of a drilled bore
     "domain": 100,  # the body itself
 }
 

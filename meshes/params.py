@@ -77,6 +77,9 @@ KNOWN: dict[str, Any] = {
     "radius": Length, "r_inner": Length, "r_outer": Length, "length": Length, "height": Length,
     "center": Point,
     "refine": Optional[Refine],
+    # orthogonal-cutting
+    "depth": Length, "uncut": Length, "pre_cut": Length, "band": Annotated[float, Field(gt=0)],
+    "fine": Annotated[float, Field(gt=0, le=1)],
 }
 
 
@@ -88,6 +91,11 @@ HELP = {
     "r_outer": "outer radius [m]", "length": "length of the body [m]", "height": "height of the body [m]",
     "center": "centre of the body [m]", "structured": "transfinite (structured) mesh, for convergence studies",
     "quarter": "model a quarter with symmetry planes", "refine": "a zone of finer elements (table below)",
+    "depth": "depth of the workpiece below the machined level [m]",
+    "uncut": "uncut chip thickness: the layer to be cut on top [m]",
+    "pre_cut": "length of the machined step the tool starts against [m]",
+    "band": "depth of the refined band below the machined level, in uncut thicknesses [1]",
+    "fine": "element size in the refined band as a fraction of h [1]",
 }
 
 
@@ -181,6 +189,18 @@ def _domain(builder: str, p: dict) -> tuple[list[float], list[float], float] | N
     if builder == "disk":
         c, r = full["center"], full["radius"]
         return [c[0] - r, c[1] - r], [c[0] + r, c[1] + r], math.pi * r ** 2
+    if builder == "sphere_section":          # (r, z) sections: the area of the section
+        r0, r1, half = full["r_inner"], full["r_outer"], full.get("half")
+        return [0.0, -r1 if half else 0.0], [r1, r1], math.pi * (r1 ** 2 - r0 ** 2) / (2 if half else 4)
+    if builder == "hollow_cylinder_section":
+        r0, r1, z = full["r_inner"], full["r_outer"], full["z"]
+        return [r0, z[0]], [r1, z[1]], (r1 - r0) * (z[1] - z[0])
+    if builder == "notched_bar":
+        r, half = full["radius"], full["length"] / 2
+        return [0.0, 0.0], [r, half], r * half
+    if "r" in full and "z" in full:
+        return [full["r"][0], full["z"][0]], [full["r"][1], full["z"][1]], \
+            (full["r"][1] - full["r"][0]) * (full["z"][1] - full["z"][0])
     if "x" in full and "y" in full:
         axes = [full["x"], full["y"]] + ([full["z"]] if "z" in full else [])
         return [a[0] for a in axes], [a[1] for a in axes], math.prod(a[1] - a[0] for a in axes)
@@ -199,6 +219,8 @@ def estimate_elements(builder: str, params: dict) -> float | None:
         return None
     lo, hi, measure = box
     dim, h = len(lo), params["h"]
+    if h ** dim == 0 or (params.get("refine") and (params["refine"].get("h") or params["refine"]["ratio"] * h) ** dim == 0):
+        return math.inf                # h so small that h^dim underflows: no machine meshes it
     count = _PER[dim] * measure / h ** dim
     refine = params.get("refine")
     if refine:

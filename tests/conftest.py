@@ -32,3 +32,9 @@ def quiet():
     """A progress callback that keeps the lines for inspection."""
     lines: list[str] = []
     return lines.append
+
+
+def edit(text: str, old: str, new: str) -> str:
+    """``text`` with its first ``old`` replaced by ``new`` (which must be there: a test edits what it means to)."""
+    assert old in text, old
+    return text.replace(old, new, 1)

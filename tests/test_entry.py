@@ -22,8 +22,12 @@ from wendel.scene import load
 from conftest import WORKFLOWS
 
 GUARDS = {"plasticity": "wendelPlasticityIdp", "contact": "wendelContactIdp", "thermal": "wendelThermalIdp",
-          "thermal-fields": "wendelThermalFieldsIdp", "elasticity": "wendelElasticityIdp", "petsc": "wendelPetscIdp"}
-MODULES = ("plasticity", "contact", "thermal", "thermal-fields")
+          "thermal-fields": "wendelThermalFieldsIdp", "elasticity": "wendelElasticityIdp",
+          "axisymmetric": "wendelAxisymmetricIdp", "axisymmetric-mechanics": "wendelAxisymmetricMechanicsIdp",
+          "remeshstop": "wendelRemeshStopIdp", "kinematics": "wendelKinematicsIdp",
+          "petsc": "wendelPetscIdp"}
+MODULES = ("plasticity", "contact", "thermal", "thermal-fields", "axisymmetric", "axisymmetric-mechanics", "remeshstop",
+           "kinematics")
 
 
 def compiled(tmp_path, scene_name: str, solver: str | None = None) -> tuple[set[str], list[str], dict]:
@@ -73,6 +77,11 @@ def test_only_a_petsc_scene_loads_the_petsc_plugin(tmp_path):
     found, switches, record = compiled(tmp_path / "petsc", "ball-indent.toml", solver="petsc")
     assert "petsc" in found and "-DWITHPETSC=1" in switches
     assert record["petsc_setups"] >= 1
+
+
+def test_updated_lagrangian_kinematics_is_compiled_only_when_the_scene_asks(tmp_path):
+    found, switches, _ = compiled(tmp_path, "ul-tension.toml")
+    assert found & set(MODULES) == {"plasticity", "kinematics"} and "-DUPDATEDLAGRANGIAN=1" in switches
 
 
 def test_a_value_of_zero_still_switches_a_module_on(tmp_path):

@@ -105,9 +105,8 @@ def test_kill9_resumes_to_the_same_result(event, tmp_path, reference):
     p.send_signal(signal.SIGKILL)
     p.wait()
     deadline = time.monotonic() + 10
-    while _freefem_of(run) and time.monotonic() < deadline:     # FreeFEM dies with its driver
-        time.sleep(0.1)
-    assert not _freefem_of(run), "FreeFEM outlived its driver"
+    while _freefem_of(run) and time.monotonic() < deadline:     # FreeFEM dies with its driver (setpriv
+        time.sleep(0.1)                                         # --pdeathsig), or the resume stops it
     if not (run / "scene.resolved.json").is_file():
         # stopped before anything was saved (a slow start): nothing to resume, the same command starts again
         r = _start("--resume", str(run))
@@ -118,6 +117,7 @@ def test_kill9_resumes_to_the_same_result(event, tmp_path, reference):
         r = _start("--resume", str(run))
     _, err = r.communicate(timeout=300)
     assert r.returncode == 0, err
+    assert not _freefem_of(run), "a FreeFEM launch of the killed driver is still running"
     same(fingerprints(run), reference)
 
 
@@ -158,3 +158,21 @@ def test_full_disk_stops_and_resumes(tmp_path, reference):
         same(fingerprints(run), reference)
     finally:
         subprocess.run(["umount", "-l", str(mnt)])
+
+
+def test_resume_stops_a_freefem_that_outlived_its_driver(tmp_path):
+    # the instant between starting a launch and arming its parent-death signal: simulated by a FreeFEM
+    # started on its own, writing into the run's fem/ folder
+    from wendel.loop.guard import stop_leftovers
+
+    fem = tmp_path / "fem"
+    fem.mkdir()
+    script = tmp_path / "spin.edp"
+    script.write_text("real s = 0; for (int i = 0; i < 2000000000; ++i) s += 1;\n")
+    p = subprocess.Popen(["FreeFem++-mpi", "-nw", "-v", "0", str(script), "-out", str(fem)],
+                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+    time.sleep(0.5)
+    assert p.poll() is None
+    assert stop_leftovers(tmp_path / "other" / "fem") == 0          # another run's folder: left alone
+    assert stop_leftovers(fem) == 1
+    assert p.wait(timeout=10) is not None and not _freefem_of(fem)

@@ -15,14 +15,9 @@ import pytest
 
 from wendel.cli import main
 
-from conftest import SMOKE_SCENE, WORKFLOWS
+from conftest import edit, SMOKE_SCENE, WORKFLOWS
 
 ROOT = Path(__file__).resolve().parents[1]
-
-
-def edit(text: str, old: str, new: str) -> str:
-    assert old in text, old
-    return text.replace(old, new, 1)
 
 
 NUMBERS = [

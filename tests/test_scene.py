@@ -7,12 +7,7 @@ import pytest
 from wendel.cli import main
 from wendel.scene import SceneError, load
 
-from conftest import SMOKE_SCENE
-
-
-def edit(text: str, old: str, new: str) -> str:
-    assert old in text, old
-    return text.replace(old, new, 1)
+from conftest import edit, SMOKE_SCENE
 
 
 BAD = [
@@ -25,14 +20,14 @@ BAD = [
     (("h = 0.025", "h = \"fine\""), "geometry.h", "valid number"),
     (("[material]", "[material]\nrho = 7800.0"), "material.rho", "unknown key"),
     (("[numerics]", "[numerix]"), "numerix", "unknown key"),
-    (("builder = \"rectangle\"", "builder = \"hexagon\""), "geometry", "unknown builder 'hexagon'; valid: box,"),
+    (("builder = \"rectangle\"", "builder = \"hexagon\""), "geometry", "unknown builder 'hexagon'; valid: axi_rectangle, box,"),
     (("x = [-1.0, 1.0]", "x = [-1.0, 1.0]\nradius = 2.0"), "geometry", "unknown key(s) radius for builder 'rectangle'"),
     (("solver = \"ffddm\"", "solver = \"amgx\""), "numerics.solver", "unknown solver 'amgx'; valid: direct, cg, ffddm, petsc"),
     (("ranks = 1", "ranks = 0"), "numerics.ranks", "greater than or equal to 1"),
     (("kind = \"step8-discs\"", "kind = \"gravity\""), "body_force.kind", "unknown body force 'gravity'"),
     (("[boundary.left]", "[boundary.west]"), "boundary.west", "unknown boundary name"),
     (("steps = 1", "steps = 0"), "loading.steps", "greater than or equal to 1"),
-    (("plane = \"strain\"", "plane = \"membrane\""), "elasticity.plane", "'strain' or 'stress'"),
+    (("plane = \"strain\"", "plane = \"membrane\""), "elasticity.plane", "'strain', 'stress' or 'axisymmetric'"),
     (("ranks = 1\nsolver = \"ffddm\"", "ranks = 2\nsolver = \"direct\""), "numerics", "runs on one rank"),
     (("description = ", "descr = "), "description", "Field required"),
 ]
@@ -116,10 +111,13 @@ def test_values_reach_freefem_as_numbers_only(tmp_path):
     path the driver wrote."""
     from conftest import WORKFLOWS
     from wendel.loop import RunFiles, options
+    from wendel.scene.blocks.cutting import FE_READY
     from wendel.scene.schema import SOLVERS
 
     for path in sorted(WORKFLOWS.glob("*.toml")):
         scene = load(path)
+        if scene.cutting is not None and not FE_READY:
+            continue    # a cut has no FE options until the chip formation exists (tests/test_cutting.py)
         files = RunFiles(tmp_path / path.stem)
         opts = options(scene, files, 3 if scene.geometry.builder == "box" else 2)
         values = opts[1::2]

@@ -1,4 +1,4 @@
-"""Command line: ``wendel run | study | check | bench``.
+"""Command line: ``wendel run | study | check | keys | sweep | oxley | bench``.
 
 Exit codes: 0 done, 1 the run failed (FreeFEM error, no convergence, disk full), 2 bad input (scene,
 options), 130 interrupted (Ctrl-C or SIGTERM; the run resumes with ``wendel run --resume DIR``).
@@ -62,13 +62,25 @@ def main(argv: list[str] | None = None) -> int:
     p = sub.add_parser("check", help="validate a scene file without running it")
     p.add_argument("scene", nargs="+")
 
+    p = sub.add_parser("oxley", help="the extended Oxley model's prediction of a cutting scene (milliseconds)")
+    p.add_argument("scene", help="scene file with a [cutting] table")
+    p.add_argument("--out", type=Path, help="folder of oxley.json and oxley.csv (default results/<scene>/oxley)")
+    p.add_argument("--no-png", action="store_true", help="no picture of the solution (oxley.png)")
+
     p = sub.add_parser("keys", help="print the scene keys (type, default, unit, range) as a Markdown table")
     p.add_argument("--update", type=Path, metavar="README", help="rewrite the table in this file instead")
 
-    p = sub.add_parser("bench", help="benchmarks; results into results/bench/")
-    p.add_argument("names", nargs="*", help="benchmarks to run: cylinder, elasticity, obstacle, petsc, remesh, "
-                   "step42, thermal (the default: all of these), step42-dealii (only when named)")
+    p = sub.add_parser("bench", help="benchmarks; results into results/bench/",
+                       formatter_class=argparse.RawTextHelpFormatter)     # names are not wrapped at hyphens
+    p.add_argument("names", nargs="*", help="benchmarks to run (default: all of these):\n"
+                   "  axisymmetric, cylinder, drilling, elasticity, obstacle, petsc, remesh, step42, sweep, thermal, ul,\n"
+                   "  oxley, oxley-domain, oxley-kienzle (the analytic orthogonal cut);\n"
+                   "only when named: step42-dealii, overhead, gmsh3d")
     p.add_argument("--quick", action="store_true", help="small sizes only")
+
+    p = sub.add_parser("sweep", help="campaigns: a plan of runs, locally or on SLURM (see wendel.sweep)")
+    from .sweep.cli import add_arguments as sweep_arguments
+    sweep_arguments(p)
 
     args = parser.parse_args(argv)
     from .errors import DiskFull, Interrupted, StepCutError
@@ -100,6 +112,15 @@ def main(argv: list[str] | None = None) -> int:
             from .results.study import study
             root = study(args.scene, levels=args.levels, smoke=args.smoke, ranks=args.np, out=args.out)
             print(f"study written to {root}")
+            return 0
+        if args.command == "sweep":
+            from .sweep.cli import command as sweep_command
+            return sweep_command(args)
+        if args.command == "oxley":
+            from .cutting.scene import analytic, summary_lines
+            record, out = analytic(args.scene, args.out, picture=not args.no_png)
+            print("\n".join(summary_lines(record)))
+            print(f"written: {out / 'oxley.json'}, {out / 'oxley.csv'}, tool polygon {out / 'tool.txt'}")
             return 0
         if args.command == "keys":
             from .scene.schema import keys_table, update_readme

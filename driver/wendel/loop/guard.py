@@ -39,3 +39,30 @@ def disk_full(root: Path) -> bool:
         return shutil.disk_usage(root).free < 64 * 1024
     except OSError:
         return False
+
+
+def stop_leftovers(fem: Path) -> int:
+    """Stop FreeFEM processes still writing into ``fem`` (the run folder's fem/): a driver killed in the
+    instant between starting a launch and arming its parent-death signal leaves one behind. Returns how
+    many were stopped."""
+    import os
+    import signal
+    import time
+
+    marker = f"-out\0{fem}\0".encode()
+    found = []
+    for pid in filter(str.isdigit, os.listdir("/proc")):
+        try:
+            cmdline = Path(f"/proc/{pid}/cmdline").read_bytes()
+        except OSError:
+            continue
+        if b"FreeFem++" in cmdline and marker in cmdline + b"\0":
+            found.append(int(pid))
+    for sig in (signal.SIGTERM, signal.SIGKILL):
+        for pid in found:
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(pid, sig)
+        deadline = time.monotonic() + 3
+        while time.monotonic() < deadline and any(Path(f"/proc/{p}").exists() for p in found):
+            time.sleep(0.05)
+    return len(found)

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from ..meshes import LABELS
 from ..scene import petsc
+from ..scene import axisymmetric
 from ..scene.blocks import BLOCKS, PROBLEMS
 from ..scene.schema import ANALYTIC_REFERENCES, BODY_FORCES, Scene
 from .checkpoint import RunFiles
@@ -42,9 +43,12 @@ def macros(scene: Scene, dimension: int) -> list[str]:
     """
     if scene.problem != "mechanics":
         return [f"-D{m}=1" for m in PROBLEMS[scene.problem].macros]
-    switches = [f"-Ddimension={dimension}", f"-DPk={ELEMENT}"]
+    switches = [f"-Ddimension={dimension}", f"-DPk={axisymmetric.element(scene, dimension) or ELEMENT}"]
     switches += [f"-D{BLOCKS[name].macro}=1" for name in scene.blocks if BLOCKS[name].macro]
     # a switch that depends on a key rather than on a block goes here: switches.append("-DNAME=1") when on
+    switches += axisymmetric.macros(scene, dimension)
+    if scene.kinematics.updated_lagrangian:
+        switches.append("-DUPDATEDLAGRANGIAN=1")     # edp/lib/kinematics.idp
     if scene.numerics.solver == "petsc":
         switches.append("-DWITHPETSC=1")       # loads wendel's PETSc plugin (lib/petsc.idp)
     return switches
@@ -64,9 +68,13 @@ def options(scene: Scene, files: RunFiles, dimension: int, segment: dict | None 
     opts += ["-mat_E", repr(m.E), "-mat_nu", repr(m.nu),
              "-el_plane_stress", "1" if scene.elasticity.plane == "stress" else "0",
              "-bc", str(files.tables / "bc.txt"), "-trac", str(files.tables / "trac.txt")]
-    for key in ("ubase", "eps0"):
-        if segment.get(key):
+    opts += axisymmetric.options(scene, dimension)
+    for key in ("ubase", "eps0"):      # updated Lagrangian: the strain is state (ul_eps.qp.txt), no pre-strain
+        if segment.get(key) and not (key == "eps0" and scene.kinematics.updated_lagrangian):
             opts += [f"-{key}", str(files.root / segment[key])]
+    if (files.tables / "motion.txt").is_file():
+        opts += ["-bc_motion", str(files.tables / "motion.txt")]
+    opts += kinematics_options(scene)
     bf = scene.body_force
     v = list(bf.value) + [0.0] * (3 - len(bf.value))
     opts += ["-body_id", str(BODY_FORCES[bf.kind]), "-body_fx", repr(v[0]), "-body_fy", repr(v[1]),
@@ -78,12 +86,25 @@ def options(scene: Scene, files: RunFiles, dimension: int, segment: dict | None 
     return opts
 
 
+def kinematics_options(scene: Scene) -> list[str]:
+    """Updated-Lagrangian kinematics (edp/lib/kinematics.idp, compiled by the -D switch of :func:`macros`)."""
+    k = scene.kinematics
+    if not k.updated_lagrangian:
+        return []
+    e = k.initial_strain
+    return ["-ul_min_jacobian", repr(k.min_area_ratio),
+            "-ul_eps_xx", repr(e[0]), "-ul_eps_yy", repr(e[1]), "-ul_eps_xy", repr(e[2])]
+
+
 def write_tables(scene: Scene, files: RunFiles, dimension: int) -> None:
     """Boundary condition tables for bc.idp (labels from meshes/labels.py)."""
     files.tables.mkdir(parents=True, exist_ok=True)
-    dirichlet, neumann = [], []
+    dirichlet, neumann, motion = [], [], []
     for name, b in scene.boundary.items():
         lab = LABELS[name]
+        if b.motion:
+            g = b.gradient or [0.0] * 4
+            motion.append(f"{lab} " + " ".join(repr(float(v)) for v in [b.rotation or 0.0, *g, *b.center]))
         for comp, val in enumerate((b.ux, b.uy, b.uz)):
             if val is not None:
                 if comp == 2 and dimension == 2:
@@ -94,3 +115,5 @@ def write_tables(scene: Scene, files: RunFiles, dimension: int) -> None:
             neumann.append(f"{lab} {t[0]!r} {t[1]!r} {t[2]!r} {float(b.pressure or 0.0)!r}")
     (files.tables / "bc.txt").write_text(f"{len(dirichlet)}\n" + "".join(r + "\n" for r in dirichlet))
     (files.tables / "trac.txt").write_text(f"{len(neumann)}\n" + "".join(r + "\n" for r in neumann))
+    if motion:
+        (files.tables / "motion.txt").write_text(f"{len(motion)}\n" + "".join(r + "\n" for r in motion))

@@ -17,13 +17,14 @@ from pathlib import Path
 from .. import freefem
 from ..errors import DiskFull, RunFolderError
 from ..meshes import build as build_mesh
+from ..remesh import batch as remesh_batch
 from ..remesh.step import finish_report, judge, maybe_remesh
 from ..results import pictures, summary, vtu
 from ..scene import load
 from ..scene.reading import check_size
 from ..scene.schema import Scene
 from .checkpoint import RunFiles, State, committed, load_state, save as _save_checkpoint
-from .guard import disk_full as _disk_full, guarded
+from .guard import disk_full as _disk_full, guarded, stop_leftovers
 from .launch import entry_script, macros, options, write_tables
 from .progress import _Progress
 from .steps import cut_step, grow_step, plan_step
@@ -79,6 +80,10 @@ def run_scene(scene: Scene, scene_path: Path, out: Path, smoke: bool = False, pr
     except OSError as exc:
         raise RunFolderError(f"run folder (--out) {out}: cannot be created or written: {exc.strerror}") from None
     check_size(scene, str(scene_path))       # h may have been scaled since the scene was read (studies)
+    if getattr(scene, "drilling", None) is not None:      # a process of removal steps: wendel.loop.drilling
+        from .drilling import run as run_drilling
+        with guarded(files.root):
+            return run_drilling(scene, scene_path, files.root, smoke, progress)
     with guarded(files.root):
         summary.write_provenance(files.root, Path(scene_path), scene, smoke)
         state = State(pending=scene.loading.load_factors())
@@ -92,6 +97,14 @@ def _execute(scene: Scene, files: RunFiles, state: State, progress) -> Path:
     dimension = json.loads(files.checkpoint.read_text())["dimension"]
     progress(f"wendel: {scene.description}")
     progress(f"  run folder {files.root}")
+    # the picture process starts its renderer while FreeFEM solves
+    with pictures.Painter(pictures.renderer(files.mesh)) if scene.output.png else contextlib.nullcontext() as painter:
+        _solve_and_report(scene, files, state, dimension, progress, painter)
+    return files.root
+
+
+def _solve_and_report(scene: Scene, files: RunFiles, state: State, dimension: int, progress, painter) -> None:
+    """Solve, write summary.json, then the picture (the run's critical path waits for the render only)."""
     try:
         segment = state.segments[-1]
         after_reequilibration = len(state.segments) > 1 and state.last[0] == segment["first"]
@@ -106,22 +119,24 @@ def _execute(scene: Scene, files: RunFiles, state: State, progress) -> Path:
         t0 = time.perf_counter()
         inc, lf = state.last
         if scene.output.vtu:
-            pictures.picture(files.vtu / f"inc-{inc:04d}.vtu", files.root / "deformed.png", f"load factor {lf:g}",
-                             scene.output.warp)
+            painter.paint(files.vtu / f"inc-{inc:04d}.vtu", files.root / "deformed.png", f"load factor {lf:g}",
+                          scene.output.warp, deformed=scene.kinematics.updated_lagrangian)
         else:            # no VTU series: the picture is made from a VTU of the last increment that is not kept
             with tempfile.TemporaryDirectory() as tmp:
-                _write_increment_vtu(files, state, dimension, inc, Path(tmp) / "last.vtu")
-                pictures.picture(Path(tmp) / "last.vtu", files.root / "deformed.png", f"load factor {lf:g}",
-                                 scene.output.warp)
-        state.post_seconds += time.perf_counter() - t0
-        summary.write_summary(files.root, scene, state, dimension)
-    return files.root
+                _write_increment_vtu(files, state, dimension, inc, Path(tmp) / "last.vtu",
+                                     scene.kinematics.updated_lagrangian)
+                painter.paint(Path(tmp) / "last.vtu", files.root / "deformed.png", f"load factor {lf:g}",
+                              scene.output.warp, deformed=scene.kinematics.updated_lagrangian)
+        summary.write_summary(files.root, scene, state, dimension, picture=time.perf_counter() - t0)
 
 
-def _write_increment_vtu(files: RunFiles, state: State, dimension: int, inc: int, path: Path) -> None:
+def _write_increment_vtu(files: RunFiles, state: State, dimension: int, inc: int, path: Path,
+                         updated_lagrangian: bool = False) -> None:
     """The VTU of accepted increment ``inc`` at ``path``."""
     points, cells = vtu.read_mesh(files.root / state.segment(inc)["mesh"], dimension)
     pdata, cdata = vtu.increment_fields(files.fem / f"inc-{inc:04d}", len(points), len(cells), dimension)
+    if updated_lagrangian:      # the VTU is the deformed body itself (points = current positions)
+        points = vtu.current_points(pdata, points)
     vtu.write_vtu(path, points, cells, dimension, pdata, cdata)
 
 
@@ -141,8 +156,8 @@ def build(scene: Scene, files: RunFiles) -> tuple[float, int]:
 def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress) -> None:
     """Launch FreeFEM on the pending increments; cut failing steps; remesh when the mesh distorts.
 
-    Without remeshing one launch runs all pending increments (start-up paid once); with remeshing each
-    launch runs one increment so that the driver judges the mesh after every increment.
+    Without remeshing one launch runs all pending increments (start-up paid once); with remeshing one
+    launch runs a remeshing segment (FreeFEM ends it after a poor mesh, :mod:`wendel.remesh.batch`).
     """
     write_tables(scene, files, dimension)
     entry = entry_script(scene, dimension)
@@ -151,8 +166,9 @@ def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress)
         inc0 = state.last[0] + 1
         if scene.loading.adaptive and not state.reequilibrate:
             plan_step(scene, state)
-        one_by_one = scene.remesh is not None or scene.loading.adaptive
-        batch = state.pending[:1] if one_by_one else list(state.pending)
+        was_reequilibration = state.reequilibrate
+        batch, stop_args = remesh_batch.plan(scene, state, dimension)
+        (files.fem / remesh_batch.STOP_FILE).unlink(missing_ok=True)
         loads = files.tables / "loads.txt"
         loads.write_text(f"{len(batch)}\n" + "".join(f"{lf!r}\n" for lf in batch))
         seg = state.segment(inc0)
@@ -165,7 +181,7 @@ def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress)
         failure, before, t0 = None, len(state.accepted), time.perf_counter()
         try:
             with watcher:
-                freefem.run(entry, switches + opts, files.fem, ranks=scene.numerics.ranks,
+                freefem.run(entry, switches + stop_args + opts, files.fem, ranks=scene.numerics.ranks,
                             timeout=scene.numerics.timeout, log=files.root / "freefem.log")
         except freefem.NewtonFailure as exc:
             failure = exc
@@ -173,7 +189,11 @@ def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress)
             accept(scene, files, state, dimension)
             state.launches.append({"wall": time.perf_counter() - t0, "increments": len(state.accepted) - before,
                                    "complete": failure is None})
-        if failure is None and len(state.accepted) - before < len(batch):
+        stopped = bool(stop_args) and remesh_batch.settle(scene, files, state, dimension, inc0, progress)
+        failure = None if stopped else failure
+        if state.reequilibrate and state.accepted and state.last[0] >= state.segments[-1]["first"]:
+            _reequilibrated(files, state, progress)     # (the launch may go on past the re-equilibration)
+        if failure is None and len(state.accepted) - before < len(batch) and not stopped:
             if _disk_full(files.root):
                 raise DiskFull(files.root)
             raise freefem.FreeFemError(f"FreeFEM ended without committing increment {state.last[0] + 1} whole "
@@ -182,11 +202,10 @@ def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress)
             cut_step(scene, files, state, failure, progress)
             _save_checkpoint(files, scene, state, dimension)
             continue
-        if scene.loading.adaptive and not state.reequilibrate:
+        if scene.loading.adaptive and not was_reequilibration:
             grow_step(scene, state, files)
-        if state.reequilibrate:
-            _reequilibrated(files, state, progress)
-        elif scene.remesh and state.pending:
+        if scene.remesh and state.pending and not (was_reequilibration
+                                                   and state.last[0] == state.segments[-1]["first"]):
             maybe_remesh(scene, files, state, dimension, progress)
         _save_checkpoint(files, scene, state, dimension)
 
@@ -195,7 +214,7 @@ def _reequilibrated(files: RunFiles, state: State, progress) -> None:
     """The increment on a new mesh is accepted: the remesh is complete (its report gets the residuals)."""
     state.reequilibrate = False
     rep = state.remeshes[-1]
-    finish_report(rep, files.fem / f"inc-{state.last[0]:04d}",
+    finish_report(rep, files.fem / f"inc-{state.segments[-1]['first']:04d}",
                   files.root / "remesh" / f"remesh-{len(state.remeshes)}.json")
     progress(f"  re-equilibrated on the new mesh: relative residual {rep['residual_after_transfer']:.2e}"
              f" -> {rep['residual_after_reequilibration']:.2e}")
@@ -228,7 +247,9 @@ def accept(scene: Scene, files: RunFiles, state: State, dimension: int) -> None:
         if scene.output.vtu:
             pdata, cdata = vtu.increment_fields(d, len(points), len(cells), dimension)
             files.vtu.mkdir(exist_ok=True)
-            vtu.write_vtu(files.vtu / f"inc-{inc:04d}.vtu", points, cells, dimension, pdata, cdata)
+            # updated-Lagrangian: the VTU is the deformed body itself (points = current positions)
+            at = vtu.current_points(pdata, points) if scene.kinematics.updated_lagrangian else points
+            vtu.write_vtu(files.vtu / f"inc-{inc:04d}.vtu", at, cells, dimension, pdata, cdata)
         state.accepted.append((inc, record["load_factor"]))
         state.pending.pop(0)
         summary.append_history(files.root, {**record, **extra}, d / "newton.csv")
@@ -273,6 +294,8 @@ def _restart(root: Path, progress) -> Path:
 
 def _resume(root: Path, progress=print) -> tuple[RunFiles, Scene, State]:
     files, scene, state, dimension = load_state(root)
+    if stop_leftovers(files.fem):
+        progress(f"  stopped a FreeFEM launch of {root} that outlived its driver")
     # An increment committed after the last checkpoint is taken as it is; a partial one is dropped.
     summary.truncate_history(files.root, state.last[0])
     accept(scene, files, state, dimension)

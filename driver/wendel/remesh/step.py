@@ -31,7 +31,8 @@ from pathlib import Path
 
 import numpy as np
 
-from . import mesher, quality, transfer
+from . import quality       # mesher (meshio, gmsh) and transfer (scipy) when a run remeshes: a run without
+                            # remeshing judges its mesh only and does not pay their imports
 from ..results import vtu
 
 SKIP_NODE = {"u", "u_total"}
@@ -44,15 +45,23 @@ def judge(points: np.ndarray, cells: np.ndarray, u: np.ndarray, dimension: int) 
     return {"min_quality": q["min"], "mean_quality": q["mean"], "inverted": q["inverted"]}
 
 
-def cell_volumes(points: np.ndarray, cells: np.ndarray) -> np.ndarray:
-    """Unsigned areas (2D) or volumes (3D)."""
-    return np.abs(quality.signed_measure(points, cells))
+def cell_volumes(points: np.ndarray, cells: np.ndarray, axisymmetric: bool = False) -> np.ndarray:
+    """Unsigned areas (2D) or volumes (3D); the volumes of revolution 2 pi r_centroid |K| of (r, z) cells.
+
+    >>> pts = np.array([[0., 0], [3, 0], [0, 1]])
+    >>> round(float(cell_volumes(pts, [[0, 1, 2]])[0]), 12), round(float(cell_volumes(pts, [[0, 1, 2]], True)[0] / np.pi), 12)
+    (1.5, 3.0)
+    """
+    vol = np.abs(quality.signed_measure(points, cells))
+    if axisymmetric:
+        vol = vol * 2 * np.pi * np.asarray(points)[np.asarray(cells), 0].mean(axis=1)
+    return vol
 
 
 def yield_violation(eps0: np.ndarray, epsp: np.ndarray, sigma_y: np.ndarray, mu: float, dimension: int) -> float:
     """Fraction of cells whose von Mises stress exceeds the yield stress after a transfer.
 
-    ``eps0``: total strain per cell (Mandel; 2D [xx, yy, sqrt2 xy]); ``epsp``: plastic strain per cell
+    ``eps0``: total strain per cell (Mandel; 2D [xx, yy, sqrt2 xy], axisymmetric [rr, zz, sqrt2 rz, theta]); ``epsp``: plastic strain per cell
     (Mandel; 2D [xx, yy, zz, sqrt2 xy], 3D as eps0). The pressure does not enter von Mises stress, so only
     the shear modulus ``mu`` is needed: s = 2 mu dev(eps - epsp).
 
@@ -61,7 +70,8 @@ def yield_violation(eps0: np.ndarray, epsp: np.ndarray, sigma_y: np.ndarray, mu:
     (1.0, 0.0)
     """
     if dimension == 2:
-        tot = np.column_stack([eps0[:, 0], eps0[:, 1], np.zeros(len(eps0)), eps0[:, 2]])
+        zz = eps0[:, 3] if eps0.shape[1] == 4 else np.zeros(len(eps0))    # the hoop strain of (r, z) models
+        tot = np.column_stack([eps0[:, 0], eps0[:, 1], zz, eps0[:, 2]])
         ee = tot - epsp
         normal, shear = ee[:, :3], ee[:, 3:]
     else:
@@ -75,25 +85,33 @@ def yield_violation(eps0: np.ndarray, epsp: np.ndarray, sigma_y: np.ndarray, mu:
 
 def remesh_state(inc_dir: Path, mesh_old: Path, ubase_old: np.ndarray | None, dimension: int,
                  mesh_new: Path, state_new: Path, h: float, h_min: float, indicator: str,
-                 mu: float | None = None) -> dict:
+                 mu: float | None = None, axisymmetric: bool = False, make_mesh=None,
+                 deformed: bool = True) -> dict:
     """Mesh the deformed body of increment ``inc_dir`` anew and write the transferred state.
 
     Writes ``mesh_new`` and, in ``state_new``, ``u.node.txt`` (zeros), ``ubase.txt``, ``eps0.txt`` and the
     module state files; returns the transfer report (without the re-equilibration residuals).
+    ``axisymmetric``: (r, z) meshes: recoveries and integrals with the volumes of revolution, the hoop strain
+    carried in ``eps0``.
+    ``make_mesh`` replaces :func:`wendel.remesh.mesher.remesh` (same arguments and report keys), e.g. the material
+    removal of :mod:`wendel.drilling`; ``deformed = False`` transfers in the reference configuration
+    (small strain: the new mesh is made from the original geometry).
     """
+    from . import mesher, transfer
+
     t0 = time.perf_counter()
     X, cells = vtu.read_mesh(mesh_old, dimension)
     X = X[:, :dimension]
     n_old = len(X)
     u = vtu.read_array(inc_dir / "u.node.txt")
-    xd = X + u.reshape(n_old, dimension)
+    xd = X + u.reshape(n_old, dimension) if deformed else X
     before = quality.mesh_quality(xd, cells, reference=X)
     cellfield = lambda name: _cells(inc_dir / f"{name}.cell.txt", len(cells))
     size_ind = None
     if indicator and (inc_dir / f"{indicator}.cell.txt").is_file():
-        size_ind = transfer.cell_to_nodes(xd, cells, cellfield(indicator)[:, 0])
+        size_ind = transfer.cell_to_nodes(xd, cells, cellfield(indicator)[:, 0], axisymmetric=axisymmetric)
     with _quiet_stdout():
-        info = mesher.remesh(xd, mesh_old, mesh_new, h, size_indicator=size_ind, h_min=h_min)
+        info = (make_mesh or mesher.remesh)(xd, mesh_old, mesh_new, h, size_indicator=size_ind, h_min=h_min)
     t1 = time.perf_counter()
     Y, new_cells = vtu.read_mesh(mesh_new, dimension)
     Y = Y[:, :dimension]
@@ -106,7 +124,8 @@ def remesh_state(inc_dir: Path, mesh_old: Path, ubase_old: np.ndarray | None, di
     # to nodes (volume-weighted, integral kept), all stacked, interpolated once, split again.
     utot = u + (ubase_old if ubase_old is not None else 0.0)
     fields = [("node", "ubase.txt", utot.reshape(n_old, dimension)),
-              ("cell", "eps0.txt", transfer.cell_to_nodes(xd, cells, mandel_strain(inc_dir, dimension)))]
+              ("cell", "eps0.txt", transfer.cell_to_nodes(xd, cells, mandel_strain(inc_dir, dimension, axisymmetric),
+                                                          axisymmetric=axisymmetric))]
     for f in sorted(inc_dir.glob("*.node.txt")):
         if f.name.removesuffix(".node.txt") not in SKIP_NODE:
             fields.append(("node", f.name, vtu.read_array(f).reshape(n_old, -1)))
@@ -116,13 +135,13 @@ def remesh_state(inc_dir: Path, mesh_old: Path, ubase_old: np.ndarray | None, di
         if v.size % len(cells):
             raise ValueError(f"{f}: {v.size} values are not a whole number per element; cannot transfer")
         qp_cells[f.name] = v.reshape(v.size // len(cells), len(cells)).T
-        fields.append(("qp", f.name, transfer.cell_to_nodes(xd, cells, qp_cells[f.name])))
+        fields.append(("qp", f.name, transfer.cell_to_nodes(xd, cells, qp_cells[f.name], axisymmetric=axisymmetric)))
     widths = [a.reshape(n_old, -1).shape[1] for _, _, a in fields]
     stacked = np.hstack([a.reshape(n_old, -1) for _, _, a in fields])
     moved, outside = transfer.transfer_nodal(xd, cells, stacked, Y)
     report["nodes_outside_old_mesh"] = int(outside)
     vtu.write_array(state_new / "u.node.txt", np.zeros(len(Y) * dimension))
-    vol_old, vol_new = cell_volumes(xd, cells), cell_volumes(Y, new_cells)
+    vol_old, vol_new = cell_volumes(xd, cells, axisymmetric), cell_volumes(Y, new_cells, axisymmetric)
     col = 0
     for (kind, name, _), w in zip(fields, widths):
         part = moved[:, col:col + w]
@@ -181,11 +200,12 @@ def _quiet_stdout():
 STRAIN = {2: ("xx", "yy", "xy"), 3: ("xx", "yy", "zz", "yz", "xz", "xy")}
 
 
-def mandel_strain(inc_dir: Path, dimension: int) -> np.ndarray:
-    """The total strain of an increment as Mandel vectors per cell (shear components x sqrt2)."""
-    comps = STRAIN[dimension]
+def mandel_strain(inc_dir: Path, dimension: int, axisymmetric: bool = False) -> np.ndarray:
+    """The total strain of an increment as Mandel vectors per cell (shear components x sqrt2); an (r, z) model
+    adds its hoop strain last (edp/lib/axisymmetric.idp's order)."""
+    comps = STRAIN[dimension] + (("hoop",) if axisymmetric else ())
     cols = [vtu.read_array(inc_dir / f"strain_{c}.cell.txt") for c in comps]
-    return np.column_stack([v * (np.sqrt(2.0) if c[0] != c[1] else 1.0) for c, v in zip(comps, cols)])
+    return np.column_stack([v * (np.sqrt(2.0) if c in ("xy", "yz", "xz") else 1.0) for c, v in zip(comps, cols)])
 
 
 def _cells(path: Path, n_cells: int) -> np.ndarray:
@@ -239,7 +259,8 @@ def maybe_remesh(scene, files, state, dimension: int, progress) -> None:
              f"{' (asked by remesh.at)' if not poor else ''}: remeshing")
     rep = remesh_state(files.fem / f"inc-{inc:04d}", files.root / seg["mesh"], ubase_old, dimension,
                                  files.root / mesh_new, files.root / state_dir, h, r.h_min or h / 3, r.indicator,
-                                 mu=scene.material.E / (2 * (1 + scene.material.nu)))
+                                 mu=scene.material.E / (2 * (1 + scene.material.nu)),
+                                 axisymmetric=scene.elasticity.plane == "axisymmetric")
     rep.update({"remesh": k, "after_increment": inc, "load_factor": lf})
     state.remeshes.append(rep)
     state.segments.append({"first": inc + 1, "mesh": mesh_new, "ubase": f"{state_dir}/ubase.txt",

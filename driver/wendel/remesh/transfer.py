@@ -244,7 +244,7 @@ def transfer_nodal(old_points, old_cells, values, new_points, tol=1e-9):
     return restore(out), int(len(outside))
 
 
-def cell_to_nodes(points, cells, cell_values, method="volume"):
+def cell_to_nodes(points, cells, cell_values, method="volume", axisymmetric=False):
     """Recover a cell field (P0, or quadrature values averaged per cell) to a continuous P1 field.
 
     Parameters
@@ -258,6 +258,8 @@ def cell_to_nodes(points, cells, cell_values, method="volume"):
         monotone: the nodal values stay within the range of the cell values). ``"l2"``: consistent L2
         projection onto P1 (more accurate for smooth fields, may over/undershoot). Both keep the
         integral of the field exactly.
+    axisymmetric : bool
+        (r, z) cells (x = r): volumes of revolution 2 pi r_centroid |K| (the integral kept is the 3D one).
 
     Returns
     -------
@@ -275,6 +277,8 @@ def cell_to_nodes(points, cells, cell_values, method="volume"):
     vv = v[:, None] if v.ndim == 1 else v
     n = len(pts)
     vol = _measure(pts, cells)
+    if axisymmetric:
+        vol = vol * (2 * np.pi * pts[cells, 0].mean(axis=1))
     npc = dim + 1
     rows = cells.ravel()
     if method == "volume":
@@ -320,7 +324,8 @@ def nodes_to_cells(cells, nodal_values):
     return np.asarray(nodal_values, dtype=float)[cells].mean(axis=1)
 
 
-def transfer_cell(old_points, old_cells, cell_values, new_points, new_cells, method="volume", tol=1e-9):
+def transfer_cell(old_points, old_cells, cell_values, new_points, new_cells, method="volume", tol=1e-9,
+                  axisymmetric=False):
     """Transfer a cell field: recover to nodes on the old mesh, interpolate, average on the new cells.
 
     Parameters
@@ -354,7 +359,7 @@ def transfer_cell(old_points, old_cells, cell_values, new_points, new_cells, met
     """
     if _same_mesh(old_points, old_cells, new_points, new_cells):
         return np.array(cell_values, dtype=float), 0
-    nodal = cell_to_nodes(old_points, old_cells, cell_values, method)
+    nodal = cell_to_nodes(old_points, old_cells, cell_values, method, axisymmetric)
     new_nodal, n_outside = transfer_nodal(old_points, old_cells, nodal, new_points, tol)
     return nodes_to_cells(new_cells, new_nodal), n_outside
 

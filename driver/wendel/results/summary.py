@@ -102,8 +102,9 @@ def read_records(root: Path) -> list[dict]:
             for d in sorted((root / "fem").glob("inc-*")) if (d / "done").is_file()]
 
 
-def write_summary(root: Path, scene, state, dimension: int) -> dict:
-    """summary.json: fingerprints of the last increment and wall time by phase."""
+def write_summary(root: Path, scene, state, dimension: int, picture: float | None = None) -> dict:
+    """summary.json: fingerprints of the last increment and wall time by phase (``picture``: the seconds
+    the run waited for deformed.png, its own phase)."""
     records = read_records(root)
     phases = {"mesh": state.mesh_seconds, "freefem_startup": 0.0, "assembly": 0.0, "linear_solve": 0.0,
               "constitutive": 0.0, "freefem_output": 0.0, "freefem_other": 0.0,
@@ -127,6 +128,8 @@ def write_summary(root: Path, scene, state, dimension: int) -> dict:
         phases["freefem_other"] += inner - rec["time_assembly"] - rec["time_solve"] - rec["time_constitutive"] - rec["time_output"]
     failed_wall = sum(l["wall"] for l, r in by_launch if r is None)
     phases["failed_launches"] = failed_wall
+    if picture is not None:
+        phases["picture"] = picture
     total = sum(phases.values())
     last = records[-1] if records else {}
     summary = {
@@ -145,7 +148,8 @@ def write_summary(root: Path, scene, state, dimension: int) -> dict:
         "solver": last.get("solver"),
         "wall_time": total,
         "wall_time_by_phase": phases,
-        "share_startup_and_io": (phases["freefem_startup"] + phases["freefem_output"] + phases["driver_output"]) / total
+        "share_startup_and_io": (phases["freefem_startup"] + phases["freefem_output"] + phases["driver_output"]
+                                 + phases.get("picture", 0.0)) / total
         if total else None,
         "remeshes": state.remeshes,
         "errors": _errors(last),

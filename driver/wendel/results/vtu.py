@@ -109,6 +109,18 @@ def increment_fields(inc_dir: Path, n_points: int, n_cells: int, dimension: int)
     return point_data, cell_data
 
 
+def current_points(point_data: dict, points: np.ndarray) -> np.ndarray:
+    """Points at the current positions of an updated-Lagrangian increment (its ``position`` field).
+
+    >>> current_points({"position": np.array([[1.0, 2.0, 0.0]])}, np.zeros((1, 3)))
+    array([[1., 2., 0.]])
+    """
+    pos = np.asarray(point_data.pop("position"), dtype=float)
+    if pos.shape != (len(points), 3):
+        raise ValueError(f"position field of shape {pos.shape} does not fit {len(points)} points")
+    return pos
+
+
 def write_vtu(path: Path, points, cells, dimension: int, point_data, cell_data) -> None:
     """Write one VTU (atomic: written beside, then renamed)."""
     mesh = meshio.Mesh(points, [(CELL_TYPES[dimension], cells)], point_data=point_data, cell_data=cell_data)

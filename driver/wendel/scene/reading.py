@@ -14,6 +14,7 @@ True
 from __future__ import annotations
 
 import copy
+import inspect
 import math
 import tomllib
 from pathlib import Path
@@ -21,7 +22,7 @@ from pathlib import Path
 from pydantic import ValidationError
 
 from ..meshes import LABELS
-from ..meshes.builders import BOUNDARIES
+from ..meshes.builders import BOUNDARIES, BUILDERS
 from ..meshes.check import inspect_file
 from ..meshes.params import estimate_elements, validate as validate_builder
 from .schema import Scene
@@ -106,10 +107,19 @@ def check_size(scene: Scene, source: str) -> None:
     if g.builder is not None:
         est = estimate_elements(g.builder, validate_builder(g.builder, g.params))
         if est is not None and est > n.max_elements:
+            # the sizes the estimate used, defaults included (a deleted radius falls back to its default)
+            sig = inspect.signature(BUILDERS[g.builder]).parameters
+            sizes = {k: v.default for k, v in sig.items() if k not in ("path", "h", "refine")
+                     and isinstance(v.default, (int, float, tuple)) and not isinstance(v.default, bool)}
+            sizes.update({k: v for k, v in g.params.items() if k in sizes})
+            used = ", ".join(f"{k} = {list(v) if isinstance(v, tuple) else v}" for k, v in sizes.items())
+            refine = g.params.get("refine")
+            if refine:
+                used += f", refined zone {', '.join(f'{k} = {v}' for k, v in refine.items())}"
             raise SceneError(
                 f"{source}: geometry.h: the mesh would have about {est:.2g} elements (estimated from h = {g.h:g} "
-                f"and the geometry), above numerics.max_elements = {n.max_elements:.3g}: use a larger h, or "
-                f"raise numerics.max_elements if this machine can hold it")
+                f"and the geometry: {used}), above numerics.max_elements = {n.max_elements:.3g}: use a larger h, "
+                f"or raise numerics.max_elements if this machine can hold it")
     loading = scene.loading
     count, key = (len(loading.factors), "loading.factors") if loading.factors else (loading.steps, "loading.steps")
     if count > n.max_increments:
@@ -125,21 +135,29 @@ def _indicator(scene: Scene, source: str) -> None:
         return
     valid = list(CELL_FIELDS) + [
         f for name in scene.blocks for f in BLOCKS[name].fields if f in BLOCK_CELL_FIELDS]
+    if scene.elasticity.plane == "axisymmetric":
+        valid.append("strain_hoop")            # the hoop strain of (r, z) models (edp/lib/mechanics.idp)
     if scene.remesh.indicator not in valid:
+        writers = [f"[{name}]" for name, b in BLOCKS.items() if scene.remesh.indicator in b.fields]
+        why = f" (it is written by {' or '.join(writers)}, which this scene does not have)" if writers else ""
         raise SceneError(f"{source}: remesh.indicator: {scene.remesh.indicator!r} is not a cell field of this "
-                         f"scene; valid: {', '.join(valid)} (or \"\" for a uniform size)")
+                         f"scene{why}; valid: {', '.join(valid)} (or \"\" for a uniform size)")
+
+
+def read_toml(path: Path, what: str = "scene") -> dict:
+    """The TOML file ``path`` (a ``what`` file) as a dict; SceneError naming the file otherwise."""
+    if not path.is_file():
+        raise SceneError(f"{path}: no such {what} file")
+    try:
+        return tomllib.loads(path.read_text())
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise SceneError(f"{path}: not valid TOML: {exc}") from None
 
 
 def load(path: str | Path, smoke: bool = False) -> Scene:
     """Read and validate the scene file ``path``; with ``smoke`` apply its [smoke] overrides."""
     path = Path(path)
-    if not path.is_file():
-        raise SceneError(f"{path}: no such scene file")
-    try:
-        data = tomllib.loads(path.read_text())
-    except tomllib.TOMLDecodeError as exc:
-        raise SceneError(f"{path}: not valid TOML: {exc}") from None
-    scene = parse(data, str(path))
+    scene = parse(read_toml(path), str(path))
     if scene.geometry.mesh is not None:
         mesh = (path.parent / scene.geometry.mesh).resolve()
         if not mesh.is_file():

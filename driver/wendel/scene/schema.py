@@ -21,16 +21,20 @@ from .blocks import BLOCKS, PROBLEMS, choice, load_all
 from ..results.comparisons import COMPARISONS
 from ..meshes import BUILDERS
 from .petsc import PRECONDITIONERS, PcName, check_options
+from .axisymmetric import REFERENCES as AXI_REFERENCES, check as check_axisymmetric
 
 # Names a scene may use, mapped to the integer ids of edp/lib/loads.idp (never code).
 BODY_FORCES = {"none": 0, "constant": 1, "step8-discs": 2, "manufactured": 3}
 ANALYTIC_REFERENCES = {"manufactured-sine": 1}
 SOLVERS = ("direct", "cg", "ffddm", "petsc")
+KINEMATICS = ("small-strain", "updated-lagrangian")
 
 BodyForceName = choice(BODY_FORCES, "body force")
 SolverName = choice(SOLVERS, "solver")
 AnalyticName = choice(ANALYTIC_REFERENCES, "analytic reference")
 ComparisonName = choice(COMPARISONS, "comparison")
+KinematicsName = choice(KINEMATICS, "kinematics")
+AxiReferenceName = choice(AXI_REFERENCES, "axisymmetric reference")
 
 
 class Strict(BaseModel):
@@ -83,7 +87,12 @@ class Material(Strict):
 class Elasticity(Strict):
     """Options of the elastic part (present in every mechanical scene)."""
 
-    plane: Literal["strain", "stress"] = Field("strain", description="2D hypothesis")
+    plane: Literal["strain", "stress", "axisymmetric"] = Field(
+        "strain", description="2D hypothesis; axisymmetric: x = r >= 0, y = z, hoop strain and 2 pi r weights")
+    order: int = Field(1, ge=1, le=2, description="Lagrange order of the displacement; 2: 2D elastic scenes "
+                       "without remeshing (-DPk=P2)")
+    reference: Optional[AxiReferenceName] = Field(
+        None, description=f"closed form of an axisymmetric scene: {', '.join(AXI_REFERENCES)}")
 
 
 class Boundary(Strict):
@@ -94,6 +103,12 @@ class Boundary(Strict):
     uz: Optional[float] = Field(None, description="prescribed z displacement at load factor 1 [m]")
     traction: Optional[list[float]] = Field(None, description="traction vector at load factor 1 [Pa]")
     pressure: Optional[float] = Field(None, description="normal pressure at load factor 1 [Pa]")
+    rotation: Optional[float] = Field(None, description="prescribed motion: rigid rotation in the x-y plane "
+                                      "about `center` (3D: about the z axis, u_z = 0) at load factor 1 (the "
+                                      "angle grows linearly with it) [rad]")
+    gradient: Optional[list[float]] = Field(None, description="prescribed motion: in-plane displacement "
+                                            "gradient [gxx, gxy, gyx, gyy] about `center` at load factor 1 [1]")
+    center: list[float] = Field([0.0, 0.0], description="centre of the prescribed motion [m]")
 
     @field_validator("traction")
     @classmethod
@@ -101,6 +116,22 @@ class Boundary(Strict):
         if v is not None and len(v) not in (2, 3):
             raise ValueError("traction has 2 (2D) or 3 (3D) components")
         return v
+
+    @model_validator(mode="after")
+    def _motion(self):
+        if self.rotation is not None or self.gradient is not None:
+            if self.gradient is not None and len(self.gradient) != 4:
+                raise ValueError("gradient has 4 components [gxx, gxy, gyx, gyy]")
+            if len(self.center) != 2:
+                raise ValueError("center has 2 components [x, y]")
+            if any(v is not None for v in (self.ux, self.uy, self.uz)):
+                raise ValueError("rotation/gradient prescribe both components: no ux/uy/uz beside them")
+        return self
+
+    @property
+    def motion(self) -> bool:
+        """Whether the boundary follows a prescribed rotation/affine motion."""
+        return self.rotation is not None or self.gradient is not None
 
 
 class BodyForce(Strict):
@@ -174,6 +205,29 @@ class Numerics(Strict):
         return self
 
 
+class Kinematics(Strict):
+    """Small strain on the mesh of the last remesh, or updated-Lagrangian large deformation
+    (edp/lib/kinematics.idp: incremental logarithmic strain, polar rotation of the increment; 2D plane strain or
+    3D, P1)."""
+
+    kind: KinematicsName = Field("small-strain", description=f"one of {', '.join(KINEMATICS)}")
+    min_area_ratio: float = Field(0.02, ge=0, lt=1, description="updated-Lagrangian: an increment that shrinks "
+                                  "a cell's area below this ratio is refused as tangling (the step is cut) [1]")
+    initial_strain: list[float] = Field([0.0, 0.0, 0.0], description="updated-Lagrangian: homogeneous initial "
+                                        "strain [xx, yy, xy] (tensor components) of a prestressed body [1]")
+
+    @field_validator("initial_strain")
+    @classmethod
+    def _initial(cls, v):
+        if len(v) != 3:
+            raise ValueError("initial_strain has 3 components [xx, yy, xy]")
+        return v
+
+    @property
+    def updated_lagrangian(self) -> bool:
+        return self.kind == "updated-lagrangian"
+
+
 class Output(Strict):
     """What a run writes besides summary.json and the histories."""
 
@@ -245,6 +299,7 @@ class SceneBase(Strict):
     elasticity: Elasticity = Elasticity()
     boundary: dict[str, Boundary] = Field(default_factory=dict, description="conditions by boundary name")
     body_force: BodyForce = BodyForce()
+    kinematics: Kinematics = Kinematics()
     loading: Loading = Loading()
     numerics: Numerics = Numerics()
     output: Output = Output()
@@ -274,8 +329,19 @@ class SceneBase(Strict):
         for name, block in BLOCKS.items():
             if block.check is not None and getattr(self, name, None) is not None:
                 block.check(getattr(self, name), self)
+        if self.kinematics.updated_lagrangian:
+            if self.problem != "mechanics":
+                raise ValueError("kinematics.kind = \"updated-lagrangian\" is for mechanics scenes")
+            if getattr(self, "thermal", None) is not None:
+                raise ValueError("kinematics.kind = \"updated-lagrangian\" is not implemented with [thermal]")
+            if self.elasticity.plane != "strain":
+                raise ValueError("kinematics.kind = \"updated-lagrangian\" needs elasticity.plane = \"strain\"")
+        elif self.kinematics.initial_strain != [0.0, 0.0, 0.0]:
+            raise ValueError("kinematics.initial_strain needs kinematics.kind = \"updated-lagrangian\"")
         if self.body_force.kind == "manufactured" and self.reference.analytic is None:
             raise ValueError("body_force.kind = \"manufactured\" needs reference.analytic")
+        if self.problem == "mechanics":
+            check_axisymmetric(self)       # elasticity.plane/order/reference against the other tables
         return self
 
     @property

@@ -90,7 +90,8 @@ class Thermal(BaseModel):
     def _steady(self):
         if self.coupling != "adiabatic" and self.duration == 0 and not any(
                 b.temperature is not None or b.h is not None for b in self.boundary.values()):
-            raise ValueError("a steady heat equation (duration = 0) needs a temperature or convection boundary")
+            raise ValueError(f"a steady heat equation (duration = 0, coupling = {self.coupling!r}) needs a "
+                             f"temperature or convection boundary")
         return self
 
     @property

@@ -1,0 +1,89 @@
+"""``wendel bench sweep``: what running a campaign costs beyond its runs.
+
+Local: 40 smoke-size runs (8 with --quick) with 2 workers. Efficiency = sum of the runs' own wall times
+(each ``wendel run`` process, as the sweep measured it) / (2 x the sweep's wall time, planning and table
+included); a second figure uses the runs' summary.json wall time (FreeFEM, meshing, output: without the
+Python start-up of each ``wendel run``). SLURM (when root and the packages are installed): a single-node
+cluster is started by scripts/slurm-local.sh, 10 runs (4 with --quick) go through submitit job arrays
+with parallelism 2; overhead per run = (2 x sweep wall time - sum of the runs' wall times) / runs, the
+same formula applied to the local sweep for comparison.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import time
+from pathlib import Path
+
+from . import register
+
+ROOT = Path(__file__).resolve().parents[3]
+
+
+def _sweep_file(workdir: Path, n: int, name: str) -> Path:
+    values = ", ".join(f"{1.0 + k:.1f}" for k in range(n))
+    p = workdir / f"{name}.toml"
+    p.write_text(f'description = "bench: {n} smoke runs"\nscene = "{ROOT / "workflows" / "smoke.toml"}"\n'
+                 f'smoke = true\noutputs = ["strain_energy"]\n[zip]\n"material.E" = [{values}]   # Pa\n'
+                 f'[slurm]\ntime = 10\nmem = "1G"\nparallelism = 2\n')
+    return p
+
+
+def _figures(rep: dict, label: str, n: int, wall: float, slots: int = 2) -> dict:
+    rows = rep["rows"]
+    run_walls = [r["run_wall"] or 0.0 for r in rows]
+    inner = [r["wall_time"] or 0.0 for r in rows]
+    return {"executor": label, "runs": n, "done": sum(r["status"] == "done" for r in rows), "slots": slots,
+            "sweep_wall": wall, "sum_run_wall": sum(run_walls), "sum_summary_wall": sum(inner),
+            "efficiency": sum(run_walls) / (slots * wall), "efficiency_summary_wall": sum(inner) / (slots * wall),
+            "overhead_per_run": (slots * wall - sum(run_walls)) / n, "mean_run_wall": sum(run_walls) / n}
+
+
+@register("sweep")
+def sweep_bench(quick: bool, workdir: Path) -> list[dict]:
+    """40 smoke runs locally on 2 workers (efficiency), and 10 through a local SLURM (overhead per run)."""
+    from ..sweep import run_sweep
+
+    shutil.rmtree(workdir, ignore_errors=True)
+    workdir.mkdir(parents=True)
+    rows = []
+    n = 8 if quick else 40
+    sweep = _sweep_file(workdir, n, "local")
+    t0 = time.perf_counter()
+    rep = run_sweep(sweep, out=workdir / "local", workers=2, quiet=True, log=lambda *_: None)
+    rows.append(_figures(rep, "local", n, time.perf_counter() - t0))
+    t0 = time.perf_counter()
+    again = run_sweep(sweep, out=workdir / "local", workers=2, quiet=True, log=lambda *_: None)
+    rows[-1]["rerun_nothing_to_do_s"] = time.perf_counter() - t0
+    assert again["skipped"] == n
+
+    needed = ("slurmctld", "slurmd", "slurmdbd", "munged", "mariadbd", "sbatch")
+    if os.geteuid() != 0 or any(shutil.which(b) is None for b in needed):
+        rows.append({"executor": "slurm", "runs": 0, "note": "skipped: needs root and " + " ".join(needed)})
+        return rows
+    m = 4 if quick else 10
+    cluster = workdir / "cluster"
+    script = ROOT / "scripts" / "slurm-local.sh"
+    t0 = time.perf_counter()
+    subprocess.run(["bash", str(script), "start", str(cluster)], check=True, capture_output=True, timeout=180)
+    start_s = time.perf_counter() - t0
+    old = os.environ.get("SLURM_CONF")
+    os.environ["SLURM_CONF"] = str(cluster / "etc" / "slurm.conf")
+    try:
+        sweep = _sweep_file(workdir, m, "slurm")
+        t0 = time.perf_counter()
+        rep = run_sweep(sweep, out=workdir / "slurm", executor="slurm", quiet=True, log=lambda *_: None)
+        rows.append({**_figures(rep, "slurm", m, time.perf_counter() - t0), "cluster_start_s": start_s})
+        local = _sweep_file(workdir, m, "local-same")
+        t0 = time.perf_counter()
+        rep = run_sweep(local, out=workdir / "local-same", workers=2, quiet=True, log=lambda *_: None)
+        rows.append(_figures(rep, "local (same runs)", m, time.perf_counter() - t0))
+    finally:
+        if old is None:
+            os.environ.pop("SLURM_CONF", None)
+        else:
+            os.environ["SLURM_CONF"] = old
+        subprocess.run(["bash", str(script), "stop", str(cluster)], capture_output=True, timeout=120)
+    return rows

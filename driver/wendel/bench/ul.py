@@ -1,0 +1,50 @@
+"""Benchmark of the updated-Lagrangian kinematics (``wendel bench ul``): the cost of an increment and of a
+Newton iteration against small strain on the same mesh and load path."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+from .. import loop as runmod
+from ..scene import load
+from . import WORKFLOWS, register
+
+
+@register("ul")
+def ul_bench(quick: bool, workdir: Path) -> list[dict]:
+    """Plane-strain compression (2D) and uniaxial tension of a cube (3D) with linear hardening to 5 % in 5
+    increments (small enough for small strain to be a fair comparison), small strain against
+    updated-Lagrangian, at growing mesh sizes."""
+    cases = [("2d", "ul-compression.toml", h) for h in ([0.04] if quick else [0.04, 0.02, 0.01])]
+    cases += [("3d", "ul-tension-3d.toml", h) for h in ([0.25] if quick else [0.25, 0.125])]
+    rows = []
+    for dim, name, h in cases:
+        path = WORKFLOWS / name
+        row = {"case": dim, "h": h}
+        for kind in ("small-strain", "updated-lagrangian"):
+            scene = load(path)
+            scene.geometry.h = h
+            scene.kinematics.kind = kind
+            scene.loading.steps = 5
+            if dim == "2d":
+                scene.boundary["top"].uy = -0.05
+            else:
+                scene.boundary["top"].uz = 0.05
+            scene.output.png = False
+            scene.output.vtu = False
+            out = workdir / f"{dim}-h{h:g}-{kind}"
+            shutil.rmtree(out, ignore_errors=True)
+            runmod.run_scene(scene, path, out, progress=lambda *_: None)
+            s = json.loads((out / "summary.json").read_text())
+            ph = s["wall_time_by_phase"]
+            work = ph["assembly"] + ph["linear_solve"] + ph["constitutive"]
+            tag = "ss" if kind == "small-strain" else "ul"
+            row.update({"dofs": s["dofs"], f"newton_{tag}": s["newton_iterations"],
+                        f"per_increment_{tag}": work / s["increments"],
+                        f"per_iteration_{tag}": work / max(s["newton_iterations"], 1)})
+        row["increment_cost_ratio"] = row["per_increment_ul"] / row["per_increment_ss"]
+        row["iteration_cost_ratio"] = row["per_iteration_ul"] / row["per_iteration_ss"]
+        rows.append(row)
+    return rows

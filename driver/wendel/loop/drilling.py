@@ -1,0 +1,414 @@
+"""The drilling process at workpiece scale: a remeshing drilling campaign (scene table ``[drilling]``).
+
+:func:`run` is the table of contents. For each process step (the drill advances by ``(depth -
+start_depth) / steps``, then dwells at the bottom):
+
+1. **remove**: the body with the bore up to the new tip depth is built anew from the geometry
+   (:mod:`wendel.meshes.drilling`: OCC boolean, graded mesh, boundaries re-tagged by geometry);
+2. **chips**: the heat content ``int rho c (T - T_0) dV`` of the removed slice (between the old and the
+   new bore) is integrated on the old mesh before removal (Gauss quadrature in (r, s, theta));
+3. **transfer**: the displacement reached, temperature and plastic variables go over to the new mesh
+   (:func:`wendel.remesh.step.remesh_state` with the removal as its ``make_mesh``, in the reference
+   configuration: small strain; the temperature by a conservative projection, see
+   :func:`wendel.remesh.removal.conservative_transfer`); the new mesh lies inside the old one, the report counts the new
+   nodes that needed extrapolation (outside the old mesh: chords of the old curved surfaces);
+4. **solve**: one FreeFEM increment of the thermo-mechanics over the step's time with the process
+   loads on the new surfaces: the heat flux ``eta_w P_c`` split between bore bottom and wall
+   (:class:`wendel.scene.blocks.drilling.Drilling` has the Kienzle force model), the thrust as a traction on
+   the bore bottom, optional convection on the bore;
+5. **write**: VTU (the series runs across every remesh), probe temperatures, bore profile, energies.
+
+Then the drill is withdrawn and the part cools on the last mesh (one launch, ``cooling_steps``
+increments). Time runs as the load factor: ``t = lf * T_total``; the traction table holds
+``thrust / A / lf`` so that the traction FreeFEM scales by ``lf`` is the thrust of the step.
+
+Energy bookkeeping (J, every step, ``summary.json["drilling"]["energy"]``): heat put in by the flux =
+change of the thermal energy of the body + heat removed with the chips - convection (and the
+thermoelastic and plastic heat) + the transfer defect (the heat the transfer onto the new mesh created).
+What is not modelled: the chips as bodies (their heat leaves at once), tool wear, the chisel edge's
+forces, the torque as a traction (3D), frictional contact of the margins with the wall.
+
+The module is above 300 lines on purpose: one process loop whose steps (remove, chips, transfer, solve,
+write) share the state of :class:`Process`; the geometry (:mod:`wendel.meshes.drilling`), the removal
+numerics (:mod:`wendel.remesh.removal`) and the outputs (:mod:`wendel.results.drilling`) live elsewhere.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .. import freefem
+from ..meshes import LABELS
+from ..meshes import drilling as geometry
+from ..remesh import mesher, quality, transfer
+from ..remesh import step as remeshing
+from ..remesh.removal import conservative_transfer, removed_slice_quadrature
+from ..results import summary as report, vtu as output
+from ..results.drilling import bore_profile, plots, write_csv
+from . import launch
+from .checkpoint import RunFiles, State
+from .quasistatic import accept
+from .steps import StepCutError
+
+
+@dataclass
+class Step:
+    """One process step: its kind (drill, dwell), the tip depth at its end (m) and its end time (s)."""
+
+    kind: str
+    depth: float
+    time: float
+
+
+def plan(block) -> tuple[list[Step], list[float]]:
+    """The removal steps and the end times of the cooling increments."""
+    steps, t = [], 0.0
+    if block.depth > block.start_depth:
+        dt = block.advance_time() / block.steps
+        dd = (block.depth - block.start_depth) / block.steps
+        for k in range(1, block.steps + 1):
+            steps.append(Step("drill", block.start_depth + k * dd, k * dt))
+        t = steps[-1].time
+    if block.dwell > 0:
+        for k in range(1, block.dwell_steps + 1):
+            steps.append(Step("dwell", block.depth, t + k * block.dwell / block.dwell_steps))
+        t = steps[-1].time
+    cooling = [t + k * block.cooling / block.cooling_steps for k in range(1, block.cooling_steps + 1)] \
+        if block.cooling > 0 else []
+    return steps, cooling
+
+
+def run(scene, scene_path: Path, out: Path, smoke: bool = False, progress=print) -> Path:
+    """Run the drilling scene ``scene`` into the folder ``out``; return it."""
+    files = RunFiles(Path(out).resolve())
+    if files.root.is_dir() and any(files.root.iterdir()):
+        raise ValueError(f"run folder {files.root} exists and is not empty: choose another --out")
+    files.root.mkdir(parents=True, exist_ok=True)
+    report.write_provenance(files.root, Path(scene_path), scene, smoke)
+    work = scene.model_copy(deep=True)
+    if smoke and scene.smoke.steps is not None:
+        work.drilling.steps = scene.smoke.steps             # smoke.steps: removal steps of a smoke run
+    scene = work.model_copy(deep=True)
+    block = scene.drilling
+    total = block.total_time()
+    work.thermal.duration = total
+    if getattr(work, "plasticity", None) is not None:
+        work.plasticity.load_time = total
+    plain = work.model_copy(update={"drilling": None})      # the mechanics + thermal entry script
+    entry = launch.entry_script(plain, 3)
+    steps, cooling = plan(block)
+    progress(f"wendel: {scene.description}")
+    progress(f"  run folder {files.root}")
+    progress(f"  P_c = {block.power():.1f} W (torque {block.drill_torque():.3g} N m), thrust "
+             f"{block.thrust_force():.1f} N, eta_w = {block.eta_w:g}; {len(steps)} removal steps, "
+             f"{len(cooling)} cooling increments, {total:.3g} s")
+    state = State(pending=[])
+    state.segments = []
+    launch.write_tables(work, files, 3)
+    proc = Process(scene, work, files, state, entry, total, progress)
+    proc.plain = plain
+    for k, step in enumerate(steps, 1):
+        proc.removal_step(k, step)
+    if cooling:
+        proc.cool(cooling)
+    summary = report.write_summary(files.root, work, state, 3)
+    proc.finish(summary)
+    return files.root
+
+
+class Process:
+    """The state of a drilling run between steps, and its records."""
+
+    def __init__(self, scene, work, files, state, entry, total, progress):
+        self.scene, self.work, self.files, self.state = scene, work, files, state
+        self.block, self.entry, self.total, self.progress = scene.drilling, entry, total, progress
+        th = work.thermal
+        self.rho_c = th.rho * th.c
+        self.T0 = th.T_initial if th.T_initial is not None else th.T_ref
+        self.g = scene.geometry
+        self.h_bore = self.block.h_bore or self.g.h / 3
+        self.rows: list[dict] = []           # one per step / cooling increment
+        self.probes: list[dict] = []
+        self.profiles: list[dict] = []
+        self.energy_prev = 0.0               # thermal energy at the end of the last step (J)
+        self.heat_boundary_prev = 0.0
+        self.heat_te_prev = 0.0
+        self.heat_pl_prev = 0.0
+        self.depth_prev = self.block.start_depth
+
+    # ---- the geometry of the workpiece
+    def build(self, depth: float, path: Path) -> dict:
+        params = {k: v for k, v in self.g.params.items() if k != "h"}
+        workpiece = "cylinder" if self.g.builder == "drilled-cylinder" else "block"
+        with remeshing._quiet_stdout():
+            geometry.drilled(path, workpiece, depth=depth, diameter=self.block.diameter,
+                             point_angle=self.block.point_angle, h=self.g.h, h_bore=self.h_bore,
+                             grade=self.block.grade, **params)
+        pts, _, cells, _, facets, tags = mesher.read_mesh(path)
+        return {"points": pts, "cells": cells, "facets": facets, "tags": tags}
+
+    def areas(self, mesh: dict) -> dict[str, float]:
+        p, f, tags = mesh["points"], mesh["facets"], mesh["tags"]
+        a = 0.5 * np.linalg.norm(np.cross(p[f[:, 1]] - p[f[:, 0]], p[f[:, 2]] - p[f[:, 0]]), axis=1)
+        return {n: float(a[tags == LABELS[n]].sum()) for n in geometry.BORE}
+
+    # ---- one removal step
+    def removal_step(self, k: int, step: Step) -> None:
+        files, state = self.files, self.state
+        t0 = time.perf_counter()
+        mesh_rel = f"meshes/step-{k:03d}.msh"
+        (files.root / "meshes").mkdir(exist_ok=True)
+        row = {"step": k, "kind": step.kind, "depth": step.depth, "time": step.time,
+               "dt": step.time - (self.rows[-1]["time"] if self.rows else 0.0)}
+        restart = None
+        if state.segments and step.depth == self.depth_prev:
+            # nothing removed (a dwell): the body and its mesh stay, the state goes on as it is
+            seg, mesh = state.segments[-1], self.mesh
+            restart = str(files.fem / f"inc-{state.last[0]:04d}")
+            row.update(chips_heat=0.0, nodes_outside_old_mesh=0, remesh_seconds=0.0, transfer_seconds=0.0,
+                       chips_seconds=0.0)
+        elif not state.segments:
+            mesh = self.build(step.depth, files.root / mesh_rel)
+            seg = {"first": k, "mesh": mesh_rel, "ubase": None, "eps0": None}
+            row.update(chips_heat=0.0, energy_after_transfer=0.0, nodes_outside_old_mesh=0,
+                       remesh_seconds=time.perf_counter() - t0, transfer_seconds=0.0, chips_seconds=0.0)
+        else:
+            old_seg = state.segments[-1]
+            old_inc = files.fem / f"inc-{state.last[0]:04d}"
+            old_mesh = self.mesh
+            tc = time.perf_counter()
+            chips, outside = self.chips_heat(old_mesh, output.read_array(old_inc / "T.node.txt"),
+                                             self.depth_prev, step.depth)
+            row["chips_seconds"] = time.perf_counter() - tc
+            built = {}
+
+            def make_mesh(xd, mesh_old, mesh_new, h, size_indicator=None, h_min=None):
+                built["mesh"] = self.build(step.depth, Path(mesh_new))
+                q = quality.mesh_quality(built["mesh"]["points"], built["mesh"]["cells"])
+                return {"min_sicn": q["min"], "measure_old": float(remeshing.cell_volumes(xd, old_mesh["cells"]).sum()),
+                        "measure_new": float(remeshing.cell_volumes(built["mesh"]["points"], built["mesh"]["cells"]).sum())}
+
+            state_rel = f"remesh/state-{k:03d}"
+            ubase_old = output.read_array(files.root / old_seg["ubase"]) if old_seg["ubase"] else None
+            rep = remeshing.remesh_state(old_inc, files.root / old_seg["mesh"], ubase_old, 3, files.root / mesh_rel,
+                                         files.root / state_rel, self.g.h, self.h_bore, "", make_mesh=make_mesh,
+                                         deformed=False)
+            mesh = built["mesh"]
+            if self.block.transfer == "conservative":
+                self.conserve_heat(old_mesh, old_inc, mesh, files.root / state_rel, rep)
+            # Small strain on nested bodies: the displacement reached is the state (its strain is compatible on
+            # the new mesh); remesh_state's pre-strain eps0 (for a remesh of the deformed body) is not used,
+            # its cell-node-cell recovery would leave incompatible strains, i.e. spurious residual stresses.
+            shutil.copyfile(files.root / state_rel / "ubase.txt", files.root / state_rel / "u.node.txt")
+            seg = {"first": k, "mesh": mesh_rel, "ubase": None, "eps0": None, "state": state_rel}
+            rep.update({"step": k, "depth_old": self.depth_prev, "depth_new": step.depth, "chips_heat": chips,
+                        "chips_points_outside": outside})
+            (files.root / "remesh").mkdir(exist_ok=True)
+            (files.root / "remesh" / f"remesh-{k:03d}.json").write_text(json.dumps(rep, indent=1))
+            state.remeshes.append(rep)
+            t_new = output.read_array(files.root / state_rel / "therm_T.node.txt")
+            row.update(chips_heat=chips, energy_after_transfer=self.energy(mesh, t_new),
+                       nodes_outside_old_mesh=rep["nodes_outside_old_mesh"], new_nodes=rep["new_nodes"],
+                       remesh_seconds=rep["remesh_seconds"], transfer_seconds=rep["transfer_seconds"])
+        if restart is None:
+            state.segments.append(seg)
+            restart = seg.get("state")
+        self.mesh = mesh
+        row["mesh_nodes"] = len(mesh["points"])
+        row["removed_volume"] = geometry.bore_volume(step.depth, self.block.diameter / 2, self.block.point_angle)
+        areas = self.areas(mesh)
+        wall_share = self.block.wall_fraction if areas["bore_wall"] > 0 else 0.0
+        q_in = self.block.eta_w * self.block.power()
+        fluxes = {"bore_wall": wall_share * q_in / areas["bore_wall"] if areas["bore_wall"] > 0 else 0.0,
+                  "bore_bottom": (1 - wall_share) * q_in / areas["bore_bottom"] if areas["bore_bottom"] > 0 else 0.0}
+        row["heat_in"] = row["dt"] * sum(fluxes[n] * areas[n] for n in fluxes)
+        row.update({f"area_{n}": a for n, a in areas.items()})
+        traction = -self.block.thrust_force() / areas["bore_bottom"] if areas["bore_bottom"] > 0 else 0.0
+        self.launch(k, [step.time], seg, fluxes, traction, restart=restart)
+        row["launch_seconds"] = self.state.launches[-1]["wall"]
+        self.depth_prev = step.depth
+        self.close_rows([row])
+
+    def conserve_heat(self, old_mesh: dict, old_inc: Path, mesh: dict, state_dir: Path, rep: dict) -> None:
+        """Replace the interpolated temperature by its lumped L2 projection (keeps the heat the body holds)."""
+        t0 = time.perf_counter()
+        T_old = output.read_array(old_inc / "therm_T.node.txt")
+        rep["energy_interpolated"] = self.energy(mesh, output.read_array(state_dir / "therm_T.node.txt"))
+        T_new, _ = conservative_transfer(old_mesh["points"], old_mesh["cells"], T_old, mesh["points"], mesh["cells"])
+        output.write_array(state_dir / "therm_T.node.txt", T_new)
+        if output.read_array(state_dir / "therm_T.qp.txt").size == len(mesh["cells"]):     # P1: one point per cell
+            output.write_array(state_dir / "therm_T.qp.txt", transfer.nodes_to_cells(mesh["cells"], T_new))
+        rep["max_T_after"] = float(T_new.max())
+        rep["transfer_seconds"] += time.perf_counter() - t0
+
+    def cool(self, times: list[float]) -> None:
+        """The drill is withdrawn: no flux, no thrust; the part cools on the last mesh."""
+        k = self.state.last[0] + 1
+        seg = self.state.segments[-1]
+        rows = [{"step": k + i, "kind": "cool", "depth": self.depth_prev, "time": t,
+                 "dt": t - (self.rows[-1]["time"] if i == 0 else times[i - 1]), "chips_heat": 0.0, "heat_in": 0.0,
+                 "nodes_outside_old_mesh": 0, "mesh_nodes": len(self.mesh["points"])} for i, t in enumerate(times)]
+        self.launch(k, times, seg, {"bore_wall": 0.0, "bore_bottom": 0.0}, 0.0,
+                    restart=str(self.files.fem / f"inc-{self.state.last[0]:04d}"))
+        self.close_rows(rows)
+
+    # ---- FreeFEM
+    def launch(self, inc0: int, times: list[float], seg: dict, fluxes: dict, traction: float, restart) -> None:
+        files, work, state = self.files, self.work, self.state
+        lfs = [t / self.total for t in times]
+        opts = launch.options(work, files, 3, seg)       # writes the scene's thermal table: replaced below
+        rows = [(LABELS[n], *b.row()) for n, b in work.thermal.boundary.items()]
+        for n, q in fluxes.items():
+            if q:
+                rows.append((LABELS[n], 1, q, 0.0))
+            if self.block.bore_h > 0:
+                rows.append((LABELS[n], 2, self.block.bore_h, self.block.bore_T_inf))
+        (files.tables / "thermal_bc.txt").write_text(
+            f"{len(rows)}\n" + "".join(f"{lab} {kind} {a!r} {b!r}\n" for lab, kind, a, b in rows))
+        trac = [line for line in (files.tables / "trac.txt").read_text().splitlines()[1:] if line.strip()]
+        trac = [r for r in trac if int(r.split()[0]) != LABELS["bore_bottom"]]
+        if traction and len(lfs) == 1:
+            trac.append(f"{LABELS['bore_bottom']} 0.0 0.0 {traction / lfs[0]!r} 0.0")
+        (files.tables / "trac.txt").write_text(f"{len(trac)}\n" + "".join(r + "\n" for r in trac))
+        loads = files.tables / "loads.txt"
+        loads.write_text(f"{len(lfs)}\n" + "".join(f"{lf!r}\n" for lf in lfs))
+        opts = launch.macros(self.plain, 3) + ["-DWITHSTRESSFIELDS=1"] + opts + ["-loads", str(loads), "-inc0", str(inc0)]
+        if restart:
+            opts += ["-restart", str(files.root / restart)]
+        state.pending = list(lfs)
+        before, t0 = len(state.accepted), time.perf_counter()
+        try:
+            freefem.run(self.entry, opts, files.fem, ranks=work.numerics.ranks, timeout=work.numerics.timeout,
+                        log=files.root / "freefem.log")
+        finally:
+            accept(work, files, state, 3)
+            state.launches.append({"wall": time.perf_counter() - t0, "increments": len(state.accepted) - before,
+                                   "complete": not state.pending})
+        if state.pending:
+            raise StepCutError(f"increment {state.last[0] + 1} of the drilling run was not accepted; "
+                                      f"see {files.root / 'freefem.log'}")
+
+    # ---- bookkeeping after a launch
+    def close_rows(self, rows: list[dict]) -> None:
+        first = self.state.last[0] - len(rows) + 1
+        for i, row in enumerate(rows):
+            inc = first + i
+            d = self.files.fem / f"inc-{inc:04d}"
+            rec = json.loads((d / "record.json").read_text())
+            T = output.read_array(d / "T.node.txt")
+            energy = self.energy(self.mesh, T)
+            start = row.get("energy_after_transfer", self.energy_prev) if i == 0 else self.energy_prev
+            row["increment"] = inc
+            row["energy"] = energy
+            row["energy_change"] = energy - start
+            row["transfer_defect"] = (start - (self.energy_prev - row["chips_heat"])) if i == 0 else 0.0
+            row["heat_boundary"] = rec["heat_boundary"] - self.heat_boundary_prev
+            row["convection"] = row["heat_boundary"] - row["heat_in"]
+            row["heat_thermoelastic"] = rec["heat_thermoelastic"] - self.heat_te_prev
+            row["heat_plastic"] = rec["heat_plastic"] - self.heat_pl_prev
+            row["freefem_energy_change"] = rec["thermal_energy_change"]
+            row["max_temperature"] = rec["max_temperature"]
+            self.heat_boundary_prev, self.heat_te_prev = rec["heat_boundary"], rec["heat_thermoelastic"]
+            self.heat_pl_prev = rec["heat_plastic"]
+            self.energy_prev = energy
+            self.rows.append(row)
+            self.record_probes(inc, row, T)
+            self.record_profile(inc, row, d)
+            self.progress(f"  step {row['step']} ({row['kind']}): depth {row['depth'] * 1e3:.3g} mm, t = {row['time']:.3g} s, "
+                          f"T_max {rec['max_temperature']:.1f} K, chips {row['chips_heat']:.3g} J, "
+                          f"{row.get('nodes_outside_old_mesh', 0)} nodes extrapolated")
+
+    def energy(self, mesh: dict, T: np.ndarray) -> float:
+        """Thermal energy of the body, int rho c (T - T_0) dV (J), exact for the P1 field."""
+        vol = remeshing.cell_volumes(mesh["points"], mesh["cells"])
+        return float(self.rho_c * vol @ transfer.nodes_to_cells(mesh["cells"], T - self.T0))
+
+    def chips_heat(self, mesh: dict, T: np.ndarray, d0: float, d1: float) -> tuple[float, int]:
+        """Heat content int rho c (T - T_0) dV of the slice the drill removes from d0 to d1 (J), on the old mesh."""
+        pts, w = removed_slice_quadrature(d0, d1, self.block.diameter / 2, self.block.point_angle,
+                                          self.g.params.get("height", 0.03), self.axis)
+        if len(pts) == 0:
+            return 0.0, 0
+        vals, outside = transfer.transfer_nodal(mesh["points"], mesh["cells"], T - self.T0, pts)
+        return float(self.rho_c * w @ vals), int(outside)
+
+    @property
+    def axis(self) -> tuple[float, float]:
+        return tuple(self.g.params.get("axis", (0.0, 0.0)))
+
+    def record_probes(self, inc: int, row: dict, T: np.ndarray) -> None:
+        if not self.block.probes:
+            return
+        names = [p.name for p in self.block.probes]
+        pos = np.array([p.position for p in self.block.probes], dtype=float)
+        inside = transfer.locate(self.mesh["points"], self.mesh["cells"], pos)[0] >= 0
+        vals, _ = transfer.transfer_nodal(self.mesh["points"], self.mesh["cells"], T, pos)
+        self.probes.append({"time": row["time"], **{n: float(v) if ok else float("nan")
+                                                     for n, v, ok in zip(names, vals, inside)}})
+
+    def record_profile(self, inc: int, row: dict, d: Path) -> None:
+        """Bore diameter error 2 u_r along the depth, and the stresses of the cells at the wall."""
+        prof = bore_profile(self.mesh, d, self.axis, self.g.params.get("height", 0.03), self.block.bore_bins)
+        if prof is not None:
+            self.profiles.append({"increment": inc, "time": row["time"], "kind": row["kind"], **prof})
+
+    # ---- summary, tables, pictures
+    def finish(self, summary: dict) -> None:
+        root = self.files.root
+        tables = root / "tables"
+        write_csv(tables / "drilling-steps.csv", self.rows)
+        if self.probes:
+            write_csv(tables / "probes.csv", self.probes)
+        rows = self.rows
+        heat_in = sum(r["heat_in"] for r in rows)
+        chips = sum(r["chips_heat"] for r in rows)
+        conv = sum(r["convection"] for r in rows)
+        te = sum(r["heat_thermoelastic"] for r in rows)
+        plastic = sum(r["heat_plastic"] for r in rows)
+        defect = sum(r["transfer_defect"] for r in rows)
+        d_energy = rows[-1]["energy"] if rows else 0.0
+        mismatch = heat_in + conv + te + plastic - d_energy - chips
+        scale = max(abs(heat_in), 1e-300)
+        shares = [(r.get("remesh_seconds", 0) + r.get("transfer_seconds", 0) + r.get("chips_seconds", 0))
+                  / max(r.get("remesh_seconds", 0) + r.get("transfer_seconds", 0) + r.get("chips_seconds", 0)
+                        + r.get("launch_seconds", 1e-300), 1e-300) for r in rows if r["kind"] != "cool"]
+        b = self.block
+        out = {
+            "process": {"power": b.power(), "torque": b.drill_torque(), "thrust": b.thrust_force(), "eta_w": b.eta_w,
+                        "wall_fraction": b.wall_fraction, "time_total": self.total,
+                        "removal_steps": sum(r["kind"] != "cool" for r in rows),
+                        "cooling_increments": sum(r["kind"] == "cool" for r in rows)},
+            "energy": {"heat_in": heat_in, "thermal_energy_change": d_energy, "chips_heat": chips,
+                       "convection": conv, "thermoelastic": te, "plastic_heat": plastic, "transfer_defect": defect,
+                       "balance_mismatch": mismatch, "balance_error": abs(mismatch) / scale},
+            "remesh": {"nodes_extrapolated": [r.get("nodes_outside_old_mesh", 0) for r in rows if r["kind"] != "cool"],
+                       "new_nodes": [r.get("new_nodes", r["mesh_nodes"]) for r in rows if r["kind"] != "cool"],
+                       "remesh_transfer_share": shares,
+                       "mean_remesh_transfer_share": float(np.mean(shares)) if shares else 0.0,
+                       "step_seconds": [r.get("remesh_seconds", 0) + r.get("transfer_seconds", 0)
+                                        + r.get("chips_seconds", 0) + r.get("launch_seconds", 0)
+                                        for r in rows if r["kind"] != "cool"]},
+            "probes_peak": {n: float(np.nanmax([p[n] for p in self.probes])) for n in (p.name for p in b.probes)} if self.probes else {},
+        }
+        if self.profiles:
+            last = self.profiles[-1]
+            drilled = [p for p in self.profiles if p["kind"] != "cool"]
+            out["bore"] = {"depth": last["depth"], "diameter_error_after": last["diameter_error"],
+                           "diameter_error_end_of_drilling": drilled[-1]["diameter_error"] if drilled else [],
+                           "hoop_stress_after": last["hoop_stress"], "axial_stress_after": last["axial_stress"]}
+        summary["drilling"] = out
+        (root / "summary.json").write_text(json.dumps(summary, indent=1))
+        (root / "drilling.json").write_text(json.dumps({**out, "steps": rows, "profiles": self.profiles}, indent=1))
+        if self.scene.output.png:
+            plots(root, rows, self.probes, self.profiles)
+        self.progress(f"  heat in {heat_in:.4g} J = stored {d_energy:.4g} + chips {chips:.4g} - convection {conv:.4g}"
+                      f" - thermoelastic {te:.3g}; mismatch {abs(mismatch) / scale:.2e} (transfer defect {defect:.3g} J)")
+        self.progress(f"  tables in {tables}, pictures and drilling.json in {root}")
+
+

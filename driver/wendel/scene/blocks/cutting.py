@@ -1,0 +1,107 @@
+"""The ``[cutting]`` block: an orthogonal cut (process, tool, and what the analytic model needs).
+
+The table describes the cut (speed, uncut chip thickness, width), the tool (rake and clearance angles,
+edge radius, face lengths), the rake-face contact (Coulomb friction, shear cap, heat partition) and the
+temperature slopes of k and c that the extended Oxley model uses (:mod:`wendel.cutting.oxley`). The
+material comes from the scene's other tables: Johnson-Cook constants from ``[plasticity]`` (law
+``johnson-cook``), density, conductivity and heat capacity from ``[thermal]`` (at ``properties_T0``).
+
+``wendel oxley SCENE.toml`` runs the analytic model from these tables. The finite-element chip
+formation (updated-Lagrangian kinematics, frictional polygon tool) is not built yet: ``wendel run`` of a
+cutting scene stops with a message saying so (:data:`FE_READY`).
+
+>>> c = Cutting(speed=200 / 60, uncut_thickness=0.15e-3, width=1.6e-3, rake=-7.0)
+>>> c.clearance, c.oxley.properties
+(7.0, 'chip')
+"""
+
+from __future__ import annotations
+
+from typing import Optional
+
+from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+from . import Block, choice, register
+
+FE_READY = False
+"""Whether the finite-element chip formation exists (issue 17; needs issues 14 and 15)."""
+
+PROPERTY_TEMPERATURES = ("shear-plane", "chip", "interface")
+PropertyTemperature = choice(PROPERTY_TEMPERATURES, "property temperature")
+
+
+class OxleyConstants(BaseModel):
+    """Constants of the extended Oxley model (Oxley 1989; Lalwani, Mehta and Jain 2009)."""
+
+    model_config = ConfigDict(extra="forbid", validate_assignment=True)
+
+    eta: float = Field(0.9, gt=0, le=1, description="shear plane temperature T_AB = T_w + eta dT_sz [1]")
+    psi: float = Field(0.9, gt=0, le=1, description="tool-chip interface temperature T_int = T_w + dT_sz + "
+                       "psi dT_M [1]")
+    properties: PropertyTemperature = Field(
+        "chip", description="temperature of the chip's k and c in the secondary zone: shear-plane (T_AB), "
+        "chip (mean chip temperature) or interface (T_int)")
+
+
+class Cutting(BaseModel):
+    """An orthogonal cut: plane strain, a rigid tool moving at ``speed`` through a layer ``uncut_thickness``."""
+
+    model_config = ConfigDict(extra="forbid", validate_assignment=True)
+
+    speed: float = Field(..., gt=0, description="cutting speed V [m/s] (200 m/min = 3.333 m/s)")
+    uncut_thickness: float = Field(..., gt=0, description="uncut chip thickness h (feed) [m]")
+    width: float = Field(..., gt=0, description="width of cut b (forces are reported for it) [m]")
+    rake: float = Field(..., gt=-45, lt=45, description="rake angle, positive when the rake face leans away "
+                        "from the chip [deg]")
+    clearance: float = Field(7.0, gt=0, lt=45, description="clearance angle of the flank face [deg]")
+    edge_radius: float = Field(0.0, ge=0, description="cutting edge radius r [m]; 0 = sharp")
+    rake_length: Optional[float] = Field(None, gt=0, description="length of the tool's rake face [m]; default "
+                                         "6 uncut_thickness")
+    flank_length: Optional[float] = Field(None, gt=0, description="length of the tool's flank face [m]; "
+                                          "default 4 uncut_thickness")
+    friction: float = Field(0.5, ge=0, description="Coulomb coefficient on the rake face [1] (FE; Merchant's "
+                            "and Lee-Shaffer's shear angles from atan of it)")
+    shear_cap: Optional[float] = Field(None, gt=0, description="cap of the friction shear stress [Pa] (FE); "
+                                       "default the chip's shear flow stress")
+    heat_to_chip: float = Field(0.5, ge=0, le=1, description="share of the frictional heat that enters the "
+                                "chip, the rest the tool [1] (FE)")
+    properties_T0: float = Field(273.15, gt=0, description="temperature at which thermal.k and thermal.c hold [K]")
+    k_slope: float = Field(0.0, description="dk/dT of the work material [W/m/K^2]")
+    c_slope: float = Field(0.0, description="dc/dT of the work material [J/kg/K^2]")
+    oxley: OxleyConstants = OxleyConstants()
+
+    @model_validator(mode="after")
+    def _edge(self):
+        if self.edge_radius > 0.5 * self.uncut_thickness:
+            raise ValueError(f"edge_radius ({self.edge_radius:g} m) above half the uncut_thickness "
+                             f"({self.uncut_thickness:g} m): the cut is ploughing, outside this model")
+        if self.rake + self.clearance >= 80:
+            raise ValueError(f"rake + clearance = {self.rake + self.clearance:g} deg leaves a wedge under 10 deg")
+        return self
+
+
+def options(block: Cutting, scene, files) -> list[str]:
+    """The FE options of the cut: refused until the chip formation exists (see :data:`FE_READY`)."""
+    raise ValueError("the finite-element chip formation of a [cutting] scene needs updated-Lagrangian "
+                     "kinematics and a frictional polygon tool, which are not merged yet (issue 17); "
+                     "`wendel oxley SCENE.toml` gives the analytic prediction of the same cut")
+
+
+def check(block: Cutting, scene) -> None:
+    """Rules joining [cutting] with [plasticity], [thermal] and [geometry], applied when the scene is read."""
+    plast = getattr(scene, "plasticity", None)
+    if plast is None or plast.law != "johnson-cook":
+        raise ValueError("cutting needs a [plasticity] table with law = \"johnson-cook\" (the work material)")
+    if getattr(scene, "thermal", None) is None:
+        raise ValueError("cutting needs a [thermal] table (density, conductivity, heat capacity of the work material)")
+    g = scene.geometry
+    if g.builder == "orthogonal-cutting":
+        uncut = (g.model_extra or {}).get("uncut")
+        if not isinstance(uncut, (int, float)) or isinstance(uncut, bool):
+            return      # absent, or not a number: the builder keywords' own validation names it
+        if abs(float(uncut) - block.uncut_thickness) > 1e-9 * block.uncut_thickness:
+            raise ValueError(f"geometry.uncut ({float(uncut):g} m) and cutting.uncut_thickness "
+                             f"({block.uncut_thickness:g} m) must be equal")
+
+
+register(Block(name="cutting", model=Cutting, options=options, check=check))

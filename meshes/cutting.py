@@ -1,0 +1,69 @@
+"""The orthogonal-cutting workpiece (plane strain): a block with the layer to be cut on top.
+
+The tool moves in -x. The machined level is y = 0; the layer 0 <= y <= uncut is the uncut chip. At the
+right end a step of length ``pre_cut`` is already machined, so the tool starts against the step face::
+
+    y = uncut  +-------------------------------+              free_surface (top and step face)
+               |            cut layer          |
+    y = 0      |                               +-------+     machined (y = 0, x >= length - pre_cut)
+               |                                       |     right
+    y = -depth +---------------------------------------+     bottom
+              x = 0                                 x = length
+
+Elements have size ``h``, graded down to ``fine * h`` in a band along the tool path (the cut layer and
+``band`` uncut chip thicknesses below the machined level, where the primary shear zone and the machined
+surface form); both are ratios, so the band follows ``h`` in studies and smoke runs.
+
+>>> import tempfile, pathlib
+>>> b = orthogonal_cutting(pathlib.Path(tempfile.mkdtemp()) / "w.msh", h=1e-4, fine=0.5)
+>>> b.boundaries
+['left', 'bottom', 'right', 'machined', 'free_surface']
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from .builders import Built, _Session, _write, register
+from .labels import LABELS
+
+
+@register("orthogonal-cutting", ["left", "bottom", "right", "machined", "free_surface"])
+def orthogonal_cutting(path: Path, length=2e-3, depth=1e-3, uncut=0.15e-3, pre_cut=0.3e-3, band=2.0,
+                       fine=0.25, h=1e-4) -> Built:
+    """Workpiece of an orthogonal cut (lengths in m): ``length`` along the cut, ``depth`` below the
+    machined level, the cut layer ``uncut`` thick, a machined step ``pre_cut`` long at the right end;
+    size ``h``, and ``fine * h`` in the band from ``band * uncut`` below the machined level to the top of
+    the cut layer."""
+    h_fine, band = fine * h, band * uncut
+    if not (0 < pre_cut < length and 0 < uncut and 0 < depth and 0 < band <= depth and 0 < fine <= 1):
+        raise ValueError("orthogonal-cutting needs 0 < pre_cut < length, uncut > 0, 0 < band * uncut <= depth "
+                         "and 0 < fine <= 1")
+    x_step = length - pre_cut
+    with _Session("orthogonal-cutting") as gmsh:
+        geo = gmsh.model.geo
+        corners = [(0.0, -depth), (length, -depth), (length, 0.0), (x_step, 0.0), (x_step, uncut), (0.0, uncut)]
+        pts = [geo.addPoint(x, y, 0.0) for x, y in corners]
+        lines = [geo.addLine(pts[i], pts[(i + 1) % len(pts)]) for i in range(len(pts))]
+        loop = geo.addCurveLoop(lines)
+        surface = geo.addPlaneSurface([loop])
+        geo.synchronize()
+        bottom, right, machined, step, top, left = lines
+        groups = {"left": [left], "bottom": [bottom], "right": [right], "machined": [machined],
+                  "free_surface": [step, top]}
+        for name, tags in groups.items():
+            gmsh.model.addPhysicalGroup(1, tags, LABELS[name], name)
+        gmsh.model.addPhysicalGroup(2, [surface], LABELS["domain"], "domain")
+        f = gmsh.model.mesh.field
+        box = f.add("Box")
+        for key, v in (("XMin", -h), ("XMax", length + h), ("YMin", -band), ("YMax", uncut + h),
+                       ("ZMin", -1.0), ("ZMax", 1.0)):
+            f.setNumber(box, key, v)
+        f.setNumber(box, "VIn", h_fine)
+        f.setNumber(box, "VOut", h)
+        f.setNumber(box, "Thickness", band)
+        f.setAsBackgroundMesh(box)
+        gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
+        gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
+        gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
+        return _write(gmsh, path, 2, list(groups))

@@ -1,0 +1,97 @@
+"""Time outside the solve (issue 20): light `check`/`keys`, the picture process, one launch per remeshing
+segment with the same results as one launch per increment."""
+
+from __future__ import annotations
+
+import json
+import resource
+import subprocess
+import sys
+
+import meshio
+import numpy as np
+import pytest
+
+from conftest import WORKFLOWS
+
+HEAVY = ("numpy", "scipy", "meshio", "vtk", "pyvista", "gmsh", "matplotlib")
+
+
+def test_check_and_keys_import_nothing_heavy_and_take_little_cpu():
+    """`wendel check` of every scene and `wendel keys`: no numerical or graphics package imported, and under
+    0.5 s of CPU (wall time on this shared machine is CPU time times its load)."""
+    code = ("import contextlib, io, sys\nfrom wendel import cli\n"
+            "with contextlib.redirect_stdout(io.StringIO()):\n"
+            "    assert cli.main(sys.argv[1:]) == 0\n"
+            f"print([m for m in {HEAVY!r} if m in sys.modules])")
+    scenes = [str(p) for p in sorted(WORKFLOWS.glob("*.toml"))]
+    for args in (["check", *scenes], ["keys"]):
+        out = subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True, check=True)
+        assert out.stdout.strip() == "[]", (args[0], out.stdout)
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    subprocess.run([sys.executable, "-m", "wendel.cli", "check", str(WORKFLOWS / "upsetting.toml")],
+                   capture_output=True, check=True)
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime
+    assert cpu < 0.5, cpu
+
+
+def _not_blank(png) -> None:
+    import matplotlib.image
+
+    rgb = matplotlib.image.imread(png)[..., :3].reshape(-1, 3)
+    background = np.median(rgb, axis=0)
+    assert (np.abs(rgb - background).sum(axis=1) > 0.1).mean() > 0.05      # a body, not an empty frame
+    assert rgb.var() > 1e-3 and len(np.unique(rgb.round(2), axis=0)) > 20  # and a colour map
+
+
+@pytest.mark.parametrize("flat, renderer", [(True, "matplotlib"), (False, "matplotlib"), (False, "pyvista")])
+def test_painter_draws_a_picture(flat, renderer, tmp_path):
+    """The picture process (matplotlib, or pyvista for big meshes) draws a PNG of a plane body and of a solid
+    that is not blank, and reports a bad request as an error instead of hanging."""
+    from wendel.results.pictures import Painter
+
+    if flat:
+        pts = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0.5, 0.5, 0]], float)
+        cells = [("triangle", np.array([[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]]))]
+        u = np.column_stack([0.01 * pts[:, 1], np.zeros(5), np.zeros(5)])
+    else:
+        pts = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 1]], float)
+        cells = [("tetra", np.array([[0, 1, 2, 3], [1, 2, 3, 4]]))]
+        u = 0.01 * pts
+    vm = np.arange(1.0, len(cells[0][1]) + 1)
+    vtu = tmp_path / "a.vtu"
+    meshio.write(vtu, meshio.Mesh(pts, cells, point_data={"u": u}, cell_data={"vonMises": [vm]}))
+    with Painter(renderer) as painter:
+        painter.paint(vtu, tmp_path / "a.png", "load factor 1")
+        with pytest.raises(RuntimeError, match="picture"):
+            painter.paint(tmp_path / "missing.vtu", tmp_path / "b.png", "x")
+    _not_blank(tmp_path / "a.png")
+
+
+def _history(run):
+    import csv
+
+    return list(csv.DictReader((run / "history.csv").open()))
+
+
+def test_one_launch_per_remeshing_segment_gives_the_same_run(tmp_path, monkeypatch):
+    """upsetting (smoke): FreeFEM ends each launch at a poor mesh (one launch per remeshing segment, the
+    re-equilibration included) and the run is the one of one launch per increment, the driver's path for
+    meshes FreeFEM does not judge (3D, several ranks)."""
+    sys.path.insert(0, str(WORKFLOWS.parent / "tests"))
+    from test_interrupt import fingerprints, same
+    from wendel.loop import run
+    from wendel.remesh import batch
+
+    segments = run(WORKFLOWS / "upsetting.toml", smoke=True, out=tmp_path / "segments", progress=lambda *_: None)
+    monkeypatch.setattr(batch, "inside_freefem", lambda scene, dimension: False)
+    single = run(WORKFLOWS / "upsetting.toml", smoke=True, out=tmp_path / "single", png=False,
+                 progress=lambda *_: None)
+    s1, s2 = (json.loads((r / "summary.json").read_text()) for r in (segments, single))
+    assert s1["remeshes"] and s1["launches"] == len(s1["remeshes"]) + 1
+    assert s2["launches"] == s2["increments"] > s1["launches"]
+    same(fingerprints(segments), fingerprints(single))
+    assert [r["min_quality"] for r in _history(segments)] == [r["min_quality"] for r in _history(single)]
+    assert s1["wall_time_by_phase"]["picture"] > 0
+    _not_blank(segments / "deformed.png")
