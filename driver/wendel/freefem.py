@@ -138,7 +138,9 @@ def run(entry: str, options: list[str], out_dir: Path, ranks: int = 1, timeout: 
         (out_dir / stale).unlink(missing_ok=True)
     # setpriv: mpirun gets SIGTERM (and stops its ranks) when the driver dies, even by kill -9
     # one rank: FreeFem++-mpi started alone (an MPI singleton), 0.2 s here against 0.5 s through mpirun
-    mpi = ["mpirun", "-np", str(ranks)] if ranks > 1 else []
+    # (not inside a SLURM job: there Open MPI's singleton looks for SLURM's PMI, which Debian's lacks, and aborts)
+    singleton = ranks == 1 and not any(k.startswith("SLURM_JOB") for k in os.environ)
+    mpi = [] if singleton else ["mpirun", "-np", str(ranks)]
     cmd = ["setpriv", "--pdeathsig", "TERM", *mpi, "FreeFem++-mpi", "-nw", "-v", "0",
            str(script), "-out", str(out_dir), *options]
     env = environment()

@@ -23,8 +23,9 @@ from ..results import pictures, summary, vtu
 from ..scene import load
 from ..scene.reading import check_size
 from ..scene.schema import Scene
-from .checkpoint import RunFiles, State, committed, load_state, save as _save_checkpoint
-from .guard import disk_full as _disk_full, guarded, stop_leftovers
+from .checkpoint import RunFiles, State, committed, save as _save_checkpoint
+from .guard import disk_full as _disk_full, guarded
+from .resume import restart, resume as resume_run
 from .launch import entry_script, macros, options, write_tables
 from .progress import _Progress
 from .steps import cut_step, grow_step, plan_step
@@ -43,9 +44,9 @@ def run(scene_path: str | Path, smoke: bool = False, ranks: int | None = None, o
     if resume is not None:
         root = Path(resume).resolve()
         if not (root / "checkpoint.json").is_file() and (root / "scene.resolved.json").is_file():
-            return _restart(root, progress)
+            return restart(root, progress)
         with guarded(root):
-            files, scene, state = _resume(root, progress)
+            files, scene, state = resume_run(root, progress)
             progress(f"resuming {files.root} after increment {state.last[0]} (load factor {state.last[1]:g})")
             return _execute(scene, files, state, progress)
     scene_path = Path(scene_path)
@@ -271,40 +272,3 @@ def _new_run_dir(scene_path: Path, smoke: bool) -> Path:
         except FileExistsError:
             k += 1
             d = base.with_name(f"{base.name}-{k}")
-
-
-def _restart(root: Path, progress) -> Path:
-    """A run stopped before its first checkpoint (while meshing): nothing was computed, so it starts again
-    in its own folder from the scene it saved there."""
-    scene = Scene.model_validate(json.loads((root / "scene.resolved.json").read_text()))
-    smoke = False
-    with contextlib.suppress(OSError, ValueError, KeyError):
-        smoke = bool(json.loads((root / "provenance.json").read_text())["smoke"])
-    progress(f"resuming {root}: it stopped before its first increment; starting it again")
-    with tempfile.TemporaryDirectory() as tmp:
-        source = Path(tmp) / "scene.toml"
-        if (root / "scene.toml").is_file():
-            shutil.copyfile(root / "scene.toml", source)
-        else:
-            source.write_text("# the scene file was not saved before the run stopped; see scene.resolved.json\n")
-        for p in root.iterdir():
-            shutil.rmtree(p) if p.is_dir() else p.unlink()
-        return run_scene(scene, source, root, smoke, progress)
-
-
-def _resume(root: Path, progress=print) -> tuple[RunFiles, Scene, State]:
-    files, scene, state, dimension = load_state(root)
-    if stop_leftovers(files.fem):
-        progress(f"  stopped a FreeFEM launch of {root} that outlived its driver")
-    # An increment committed after the last checkpoint is taken as it is; a partial one is dropped.
-    summary.truncate_history(files.root, state.last[0])
-    accept(scene, files, state, dimension)
-    if state.reequilibrate and state.accepted and state.last[0] >= state.segments[-1]["first"]:
-        _reequilibrated(files, state, progress)      # stopped after the re-equilibration was committed
-        _save_checkpoint(files, scene, state, dimension)
-    nxt = files.fem / f"inc-{state.last[0] + 1:04d}"
-    if nxt.is_dir():
-        shutil.rmtree(nxt)
-    return files, scene, state
-
-
