@@ -5,13 +5,14 @@ SHELL := /bin/bash
 PYTHON ?= python3
 VENV := .venv
 APT_PACKAGES := freefem++ libfreefem++-dev openmpi-bin libopenblas0-pthread g++ \
-                libegl1 libegl-mesa0 libgl1 libgl1-mesa-dri libglu1-mesa
+                libegl1 libegl-mesa0 libgl1 libgl1-mesa-dri libglu1-mesa \
+                libpetsc-real3.18-dev
 # Test only: a single-node SLURM with accounting for the sweep tests (scripts/slurm-local.sh).
 APT_TEST_PACKAGES := slurmctld slurmd slurm-client slurmdbd munge mariadb-server
 SCENE ?= workflows/smoke.toml
 
 .PHONY: setup run test bench clean
-setup: build/.apt-ok $(VENV)/.ok build/plugins/MUMPS_mpi.so
+setup: build/.apt-ok $(VENV)/.ok build/plugins/MUMPS_mpi.so build/plugins/wendel_petsc.so
 
 # Debian packages: FreeFEM, Open MPI, OpenBLAS under FreeFEM's direct solvers, Mesa for off-screen pictures.
 build/.apt-ok: Makefile
@@ -37,6 +38,14 @@ $(VENV)/.ok: pyproject.toml constraints.txt
 build/plugins/MUMPS_mpi.so: edp/MUMPS_mpi_placeholder.cpp build/.apt-ok
 	@mkdir -p build/plugins
 	g++ -shared -fPIC -O1 -w -I/usr/include/freefem++ $< -o $@
+
+# wendel's PETSc plugin (lib/solver.idp, -solver petsc): Debian's PETSc 3.18 with hypre, ML and GAMG.
+PETSC_DIR := /usr/lib/petscdir/petsc3.18/x86_64-linux-gnu-real
+build/plugins/wendel_petsc.so: edp/plugins/wendel_petsc.cpp build/.apt-ok
+	@mkdir -p build/plugins
+	g++ -shared -fPIC -O2 -Wall -Wno-unused-variable -Wno-sign-compare -Wno-mismatched-new-delete -isystem /usr/include/freefem++ -isystem $(PETSC_DIR)/include \
+	  -I/usr/lib/x86_64-linux-gnu/openmpi/include -DOMPI_SKIP_MPICXX $< -o $@ \
+	  -L$(PETSC_DIR)/lib -Wl,-rpath,$(PETSC_DIR)/lib -lpetsc_real -lmpi
 
 run: setup
 	$(VENV)/bin/wendel run $(SCENE)

@@ -25,14 +25,16 @@ GUARDS = {"plasticity": "wendelPlasticityIdp", "contact": "wendelContactIdp", "t
           "thermal-fields": "wendelThermalFieldsIdp", "elasticity": "wendelElasticityIdp",
           "axisymmetric": "wendelAxisymmetricIdp", "axisymmetric-mechanics": "wendelAxisymmetricMechanicsIdp",
           "remeshstop": "wendelRemeshStopIdp", "kinematics": "wendelKinematicsIdp",
-          "friction": "wendelFrictionIdp", "tool": "wendelToolIdp"}
+          "friction": "wendelFrictionIdp", "tool": "wendelToolIdp", "petsc": "wendelPetscIdp"}
 MODULES = ("plasticity", "contact", "thermal", "thermal-fields", "axisymmetric", "axisymmetric-mechanics", "remeshstop",
            "kinematics", "friction", "tool")
 
 
-def compiled(tmp_path, scene_name: str) -> tuple[set[str], list[str], dict]:
+def compiled(tmp_path, scene_name: str, solver: str | None = None) -> tuple[set[str], list[str], dict]:
     """Launch the scene's entry at verbosity 1; return (modules compiled, -D switches, first record)."""
     scene = load(WORKFLOWS / scene_name, smoke=True)
+    if solver:
+        scene.numerics.solver = solver
     files = RunFiles(tmp_path / scene_name.removesuffix(".toml"))
     files.root.mkdir(parents=True)
     dimension = build(scene.geometry.builder, files.mesh, **scene.geometry.params).dimension
@@ -68,6 +70,14 @@ def test_each_block_compiles_its_module_and_only_it(tmp_path, scene_name, module
     found, switches, _ = compiled(tmp_path, scene_name)
     assert found & set(MODULES) == modules, found
     assert {f"-DWITH{m.upper()}=1" for m in modules if m not in ("thermal-fields", "tool")} <= set(switches)
+
+
+def test_only_a_petsc_scene_loads_the_petsc_plugin(tmp_path):
+    found, switches, record = compiled(tmp_path / "cg", "ball-indent.toml")
+    assert "petsc" not in found and "-DWITHPETSC=1" not in switches
+    found, switches, record = compiled(tmp_path / "petsc", "ball-indent.toml", solver="petsc")
+    assert "petsc" in found and "-DWITHPETSC=1" in switches
+    assert record["petsc_setups"] >= 1
 
 
 def test_updated_lagrangian_kinematics_is_compiled_only_when_the_scene_asks(tmp_path):

@@ -22,7 +22,7 @@ BAD = [
     (("[numerics]", "[numerix]"), "numerix", "unknown key"),
     (("builder = \"rectangle\"", "builder = \"hexagon\""), "geometry", "unknown builder 'hexagon'; valid: axi_rectangle, box,"),
     (("x = [-1.0, 1.0]", "x = [-1.0, 1.0]\nradius = 2.0"), "geometry", "unknown key(s) radius for builder 'rectangle'"),
-    (("solver = \"ffddm\"", "solver = \"petsc\""), "numerics.solver", "unknown solver 'petsc'; valid: direct, cg, ffddm"),
+    (("solver = \"ffddm\"", "solver = \"amgx\""), "numerics.solver", "unknown solver 'amgx'; valid: direct, cg, ffddm, petsc"),
     (("ranks = 1", "ranks = 0"), "numerics.ranks", "greater than or equal to 1"),
     (("kind = \"step8-discs\"", "kind = \"gravity\""), "body_force.kind", "unknown body force 'gravity'"),
     (("[boundary.left]", "[boundary.west]"), "boundary.west", "unknown boundary name"),

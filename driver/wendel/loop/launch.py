@@ -9,6 +9,7 @@ problems (:class:`wendel.scene.blocks.Problem`) name their own entry script and 
 from __future__ import annotations
 
 from ..meshes import LABELS
+from ..scene import petsc
 from ..scene import axisymmetric
 from ..scene.blocks import BLOCKS, PROBLEMS
 from ..scene.schema import ANALYTIC_REFERENCES, BODY_FORCES, Scene
@@ -52,6 +53,8 @@ def macros(scene: Scene, dimension: int) -> list[str]:
         switches.append("-DUPDATEDLAGRANGIAN=1")     # edp/lib/kinematics.idp
     if getattr(scene, "contact", None) is not None and scene.contact.current_configuration:
         switches.append("-DWITHFRICTION=1")      # friction, tool, path or force control: edp/lib/friction.idp
+    if scene.numerics.solver == "petsc":
+        switches.append("-DWITHPETSC=1")       # loads wendel's PETSc plugin (lib/petsc.idp)
     return switches
 
 
@@ -61,6 +64,8 @@ def options(scene: Scene, files: RunFiles, dimension: int, segment: dict | None 
     segment = segment or {"mesh": "mesh.msh", "ubase": None, "eps0": None}
     opts = ["-mesh", str(files.root / segment["mesh"]), "-solver", n.solver, "-solver_tol", repr(n.solver_tol),
             "-newton_tol", repr(n.newton_tol), "-newton_maxit", str(n.newton_maxit)]
+    if n.solver == "petsc":
+        opts += petsc.launch_options(n.petsc.pc, n.petsc.options, n.petsc.reuse)
     if scene.problem != "mechanics":
         return opts + PROBLEMS[scene.problem].options(scene, files, dimension)
     m = scene.material

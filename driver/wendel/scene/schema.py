@@ -20,12 +20,13 @@ from pydantic import BaseModel, ConfigDict, Field, create_model, field_validator
 from .blocks import BLOCKS, PROBLEMS, choice, load_all
 from ..results.comparisons import COMPARISONS
 from ..meshes import BUILDERS
+from .petsc import PRECONDITIONERS, PcName, check_options
 from .axisymmetric import REFERENCES as AXI_REFERENCES, check as check_axisymmetric
 
 # Names a scene may use, mapped to the integer ids of edp/lib/loads.idp (never code).
 BODY_FORCES = {"none": 0, "constant": 1, "step8-discs": 2, "manufactured": 3}
 ANALYTIC_REFERENCES = {"manufactured-sine": 1}
-SOLVERS = ("direct", "cg", "ffddm")
+SOLVERS = ("direct", "cg", "ffddm", "petsc")
 KINEMATICS = ("small-strain", "updated-lagrangian")
 
 BodyForceName = choice(BODY_FORCES, "body force")
@@ -166,6 +167,21 @@ class Loading(Strict):
         return min(abs(b - a) for a, b in zip([0.0] + t[:-1], t)) or 1.0
 
 
+class Petsc(Strict):
+    """The PETSc solver (numerics.solver = "petsc"): CG + a preconditioner preset, PETSc options on top."""
+
+    pc: PcName = Field("ml", description=f"preconditioner: {', '.join(PRECONDITIONERS)}")
+    options: str = Field("", description="more PETSc options, \"-name value\" pairs (e.g. \"-ksp_rtol 1e-8\"); "
+                         "they override the preset; no option that reads or writes files")
+    reuse: bool = Field(True, description="keep the preconditioner across Newton steps and increments while "
+                        "the iterations stay below 1.5x those right after its setup")
+
+    @field_validator("options")
+    @classmethod
+    def _options(cls, v):
+        return check_options(v)
+
+
 class Numerics(Strict):
     """Solver settings."""
 
@@ -175,6 +191,7 @@ class Numerics(Strict):
     newton_tol: float = Field(1e-9, gt=0, lt=1, description="relative Newton residual [1]")
     newton_maxit: int = Field(25, ge=1, le=500, description="Newton iterations per increment")
     timeout: float = Field(3600.0, gt=0, description="wall-time limit of one FreeFEM launch [s]")
+    petsc: Petsc = Field(default_factory=Petsc, description="PETSc solver settings (solver = \"petsc\")")
     max_elements: float = Field(3e6, gt=0, description="refuse a mesh estimated above this many elements before "
                                 "meshing (about 1 GB per 300k 3D elements here; raise it on a bigger machine) [1]")
     max_increments: int = Field(100000, ge=1, description="refuse a load path of more increments than this [1]")
@@ -182,8 +199,9 @@ class Numerics(Strict):
 
     @model_validator(mode="after")
     def _ranks(self):
-        if self.ranks > 1 and self.solver != "ffddm":
-            raise ValueError(f"solver {self.solver!r} runs on one rank; use solver = \"ffddm\" with ranks = {self.ranks}")
+        if self.ranks > 1 and self.solver not in ("ffddm", "petsc"):
+            raise ValueError(f"solver {self.solver!r} runs on one rank; use solver = \"ffddm\" or \"petsc\" "
+                             f"with ranks = {self.ranks}")
         return self
 
 
