@@ -178,6 +178,30 @@ def run(entry: str, options: list[str], out_dir: Path, ranks: int = 1, timeout: 
     raise FreeFemError(f"FreeFEM error (exit code {rc}) in {message}\n(full log: {log})", file, line, log)
 
 
+def terminate(pids: list[int], grace: float = 3.0) -> None:
+    """SIGTERM the processes ``pids``, then SIGKILL those still there after ``grace`` seconds (processes
+    of a run found by their command line: a launch that outlived its driver, an earlier sweep attempt)."""
+    for sig in (signal.SIGTERM, signal.SIGKILL):
+        left = [p for p in pids if alive(p)]
+        for p in left:
+            try:
+                os.kill(p, sig)
+            except ProcessLookupError:
+                pass
+        deadline = time.monotonic() + grace
+        while time.monotonic() < deadline and any(alive(p) for p in left):
+            time.sleep(0.05)
+
+
+def alive(pid: int) -> bool:
+    """Whether the process ``pid`` exists (a zombie counts until it is reaped)."""
+    try:
+        os.kill(pid, 0)
+        return True
+    except ProcessLookupError:
+        return False
+
+
 def _kill(proc: subprocess.Popen) -> None:
     """Stop mpirun and its ranks (the whole process group)."""
     for sig in (signal.SIGTERM, signal.SIGKILL):

@@ -43,11 +43,9 @@ def disk_full(root: Path) -> bool:
 
 def stop_leftovers(fem: Path) -> int:
     """Stop FreeFEM processes still writing into ``fem`` (the run folder's fem/): a driver killed in the
-    instant between starting a launch and arming its parent-death signal leaves one behind. Returns how
-    many were stopped."""
+    instant between starting a launch and arming its parent-death signal leaves one behind. Only FreeFEM
+    launches are matched (a resume must not stop, say, a `tail -f` of the run's log). Returns how many."""
     import os
-    import signal
-    import time
 
     marker = f"-out\0{fem}\0".encode()
     found = []
@@ -58,11 +56,5 @@ def stop_leftovers(fem: Path) -> int:
             continue
         if b"FreeFem++" in cmdline and marker in cmdline + b"\0":
             found.append(int(pid))
-    for sig in (signal.SIGTERM, signal.SIGKILL):
-        for pid in found:
-            with contextlib.suppress(ProcessLookupError):
-                os.kill(pid, sig)
-        deadline = time.monotonic() + 3
-        while time.monotonic() < deadline and any(Path(f"/proc/{p}").exists() for p in found):
-            time.sleep(0.05)
+    freefem.terminate(found)
     return len(found)

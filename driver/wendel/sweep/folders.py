@@ -23,6 +23,8 @@ import threading
 import time
 from pathlib import Path
 
+from ..freefem import alive, terminate
+
 DONE, FAILED, INTERRUPTED, PENDING, STALE = "done", "failed", "interrupted", "pending", "stale"
 EXIT_INTERRUPTED = 130
 """``wendel run`` stopped by Ctrl-C or SIGTERM: FreeFEM stopped, the run resumable."""
@@ -199,25 +201,8 @@ def stop_leftovers(folder: Path) -> list[int]:
                 continue
             if mark in cmd or cmd.rstrip().endswith(str(folder)):
                 found.append(int(d.name))
-    for sig in (signal.SIGTERM, signal.SIGKILL):
-        left = [p for p in found if _alive(p)]
-        for p in left:
-            try:
-                os.kill(p, sig)
-            except ProcessLookupError:
-                pass
-        deadline = time.monotonic() + 5.0
-        while time.monotonic() < deadline and any(_alive(p) for p in left):
-            time.sleep(0.05)
+    terminate(found, grace=5.0)
     return found
-
-
-def _alive(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-        return True
-    except ProcessLookupError:
-        return False
 
 
 def stop_process(proc: subprocess.Popen, grace: float = 10.0) -> None:
@@ -240,7 +225,7 @@ def stop_process(proc: subprocess.Popen, grace: float = 10.0) -> None:
     except subprocess.TimeoutExpired:
         pass
     for sig in (signal.SIGTERM, signal.SIGKILL):
-        left = [p for p in [proc.pid, *tree] if _alive(p)]
+        left = [p for p in [proc.pid, *tree] if alive(p)]
         if not left:
             return
         for g in groups | {proc.pid}:
@@ -249,7 +234,7 @@ def stop_process(proc: subprocess.Popen, grace: float = 10.0) -> None:
             except ProcessLookupError:
                 pass
         deadline = time.monotonic() + 5.0
-        while time.monotonic() < deadline and any(_alive(p) for p in left):
+        while time.monotonic() < deadline and any(alive(p) for p in left):
             try:
                 proc.wait(timeout=0.1)
             except subprocess.TimeoutExpired:
