@@ -24,7 +24,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .builders import Built, _Session, _write, register
+from .builders import Built, _Session, _size_field, _write, register
 from .labels import LABELS
 
 
@@ -54,16 +54,6 @@ def orthogonal_cutting(path: Path, length=2e-3, depth=1e-3, uncut=0.15e-3, pre_c
         for name, tags in groups.items():
             gmsh.model.addPhysicalGroup(1, tags, LABELS[name], name)
         gmsh.model.addPhysicalGroup(2, [surface], LABELS["domain"], "domain")
-        f = gmsh.model.mesh.field
-        box = f.add("Box")
-        for key, v in (("XMin", -h), ("XMax", length + h), ("YMin", -band), ("YMax", uncut + h),
-                       ("ZMin", -1.0), ("ZMax", 1.0)):
-            f.setNumber(box, key, v)
-        f.setNumber(box, "VIn", h_fine)
-        f.setNumber(box, "VOut", h)
-        f.setNumber(box, "Thickness", band)
-        f.setAsBackgroundMesh(box)
-        gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
-        gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
-        gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
+        # the refined band along the tool path: a block zone of the builders' size field
+        _size_field(gmsh, h, {"box": [[-h, -band], [length + h, uncut + h]], "h": h_fine, "thickness": band})
         return _write(gmsh, path, 2, list(groups))
