@@ -176,3 +176,23 @@ def test_resume_stops_a_freefem_that_outlived_its_driver(tmp_path):
     assert stop_leftovers(tmp_path / "other" / "fem") == 0          # another run's folder: left alone
     assert stop_leftovers(fem) == 1
     assert p.wait(timeout=10) is not None and not _freefem_of(fem)
+
+
+@pytest.mark.parametrize("stopped", ["empty", "blank line"])
+def test_history_created_but_headerless_is_rebuilt(tmp_path, stopped):
+    """A stop in the instant after history.csv was created and before its header was written (seen once in a
+    fresh-clone CI under SIGTERM) leaves a header-less file: the resume drops it and the next row writes the
+    header again, instead of taking the first data row for the header."""
+    from wendel.results import summary
+
+    (tmp_path / "history.csv").write_text("" if stopped == "empty" else "\n")
+    (tmp_path / "newton.csv").write_text("")
+    summary.truncate_history(tmp_path, 0)
+    newton = tmp_path / "inc" / "newton.csv"
+    newton.parent.mkdir()
+    newton.write_text("increment,iteration,residual\n1,1,1e-3\n1,2,1e-9\n")
+    for inc in (1, 2):
+        summary.append_history(tmp_path, {"increment": inc, "load_factor": 0.5 * inc, "name": "x"}, newton)
+    rows = list(csv.DictReader((tmp_path / "history.csv").open()))
+    assert [(r["increment"], r["load_factor"]) for r in rows] == [("1", "0.5"), ("2", "1.0")]
+    assert (tmp_path / "newton.csv").read_text().splitlines()[0] == "increment,iteration,residual"

@@ -66,7 +66,7 @@ def append_history(root: Path, record: dict, newton_csv: Path) -> None:
     """One row per accepted increment in history.csv; its Newton rows appended to newton.csv."""
     hist = root / "history.csv"
     keys = [k for k, v in record.items() if isinstance(v, (int, float))]
-    new = not hist.exists()
+    new = not hist.exists() or hist.stat().st_size == 0   # created empty by a run stopped in this instant
     with open(hist, "a", newline="") as f:
         w = csv.DictWriter(f, fieldnames=keys, extrasaction="ignore")
         if new:
@@ -75,7 +75,7 @@ def append_history(root: Path, record: dict, newton_csv: Path) -> None:
     rows = newton_csv.read_text().splitlines() if newton_csv.is_file() else []
     all_newton = root / "newton.csv"
     if rows:
-        header = not all_newton.exists()
+        header = not all_newton.exists() or all_newton.stat().st_size == 0
         with open(all_newton, "a") as f:
             f.write("\n".join(rows if header else rows[1:]) + "\n")
 
@@ -87,7 +87,11 @@ def truncate_history(root: Path, last_increment: int) -> None:
         if not path.is_file():
             continue
         lines = path.read_text().splitlines()
-        width = len(lines[0].split(",")) if lines else 0
+        if not lines or not lines[0].startswith("increment,"):
+            # created but stopped before its header was written: the next accepted increment writes it
+            path.unlink()
+            continue
+        width = len(lines[0].split(","))
         # a row cut short by a crash or a full disk has fewer fields than the header: dropped
         keep = lines[:1] + [l for l in lines[1:] if len(l.split(",")) == width
                             and int(float(l.split(",", 1)[0])) <= last_increment]
