@@ -15,16 +15,9 @@ SCENE ?= workflows/smoke.toml
 setup: build/.apt-ok $(VENV)/.ok build/plugins/MUMPS_mpi.so build/plugins/wendel_petsc.so
 
 # Debian packages: FreeFEM, Open MPI, OpenBLAS under FreeFEM's direct solvers, Mesa for off-screen pictures.
-build/.apt-ok: Makefile
+build/.apt-ok: Makefile scripts/apt-ensure.sh
 	@mkdir -p build
-	@n_ok=$$(dpkg-query -W -f='$${Status}\n' $(APT_PACKAGES) 2>/dev/null | grep -c '^install ok installed$$'); \
-	if [ "$$n_ok" -eq "$(words $(APT_PACKAGES))" ]; then \
-	  echo "apt: all packages present"; \
-	else \
-	  echo "apt: installing $(APT_PACKAGES)"; \
-	  SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
-	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq --no-install-recommends $(APT_PACKAGES); \
-	fi
+	scripts/apt-ensure.sh packages $(APT_PACKAGES)
 	@touch $@
 
 # Python: a venv with the package in editable mode, versions pinned by constraints.txt.
@@ -51,17 +44,9 @@ run: setup
 	$(VENV)/bin/wendel run $(SCENE)
 
 # SLURM, munge and MariaDB for tests/test_sweep.py (their daemons are started by the test, not by apt).
-build/.apt-test-ok: Makefile
+build/.apt-test-ok: Makefile scripts/apt-ensure.sh
 	@mkdir -p build
-	@n_ok=$$(dpkg-query -W -f='$${Status}\n' $(APT_TEST_PACKAGES) 2>/dev/null | grep -c '^install ok installed$$'); \
-	if [ "$$n_ok" -eq "$(words $(APT_TEST_PACKAGES))" ]; then \
-	  echo "apt: test packages present"; \
-	else \
-	  echo "apt: installing $(APT_TEST_PACKAGES)"; \
-	  SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
-	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq --no-install-recommends $(APT_TEST_PACKAGES) \
-	    || echo "apt: test packages not installed: the SLURM tests will be skipped"; \
-	fi
+	scripts/apt-ensure.sh "test packages" --optional $(APT_TEST_PACKAGES)
 	@touch $@
 
 test: setup build/.apt-test-ok
