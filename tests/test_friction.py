@@ -297,3 +297,44 @@ def test_friction_bench_at_smoke_sizes(tmp_path):
     assert by[("sliding-block", "Coulomb mu = 0.3")]["friction_ratio"] == pytest.approx(0.3, rel=1e-8)
     # friction costs Newton iterations, but not many more than the frictionless solve (measured 1.5x on Hertz)
     assert by[("hertz", "Coulomb mu = 0.3")]["iterations_vs_frictionless"] <= 2.0
+
+
+def test_insulated_thin_strip_warms_as_the_1d_closed_form(tmp_path):
+    # A 3.5 mm steel strip (nu = 0: pressing gives no lateral slip) dragged at v = 50 mm/s with Tresca friction
+    # tau = 1 MPa: every contact node slides from the first drag increment on, so half the frictional work
+    # enters the bottom face as the uniform flux q = 0.5 tau v, and the insulated strip is the slab 0 < y < L
+    # heated through y = 0 (Carslaw and Jaeger, Conduction of Heat in Solids, 2nd ed. 1959, sec. 3.3):
+    #   T - T0 = q t / (rho c L) + q L / k [(1 - y/L)^2 / 2 - 1/6 - 2/pi^2 sum cos(n pi y/L) e^(-n^2 pi^2 a t/L^2) / n^2]
+    # At the end (a t / L^2 = 0.97) the FE temperature is within 1.6e-3 of the face's rise at every node
+    # (measured; 4.8e-4 at h/2, 1.44e-3 with dt/2: the error is the mesh's, backward Euler's transient part
+    # has decayed); tolerance 5e-3 of the rise. The strip's mean rise is exact (energy, 1e-6).
+    from wendel.results import vtu as output
+
+    root = run(WORKFLOWS / "heat-strip.toml", out=tmp_path / "hs", png=False, progress=lambda *_: None)
+    recs = records(root)
+    L, k, rho_c, q = 0.0035, 44.5, 7830.0 * 477.0, 0.5 * 1.0e6 * 0.05
+    a = k / rho_c
+
+    def rise(y, t):
+        xi, s = y / L, 0.0
+        for n in range(1, 400):
+            s = s + np.cos(n * math.pi * xi) * math.exp(-(n * math.pi) ** 2 * a * t / L ** 2) / n ** 2
+        return q * t / (rho_c * L) + q * L / k * ((1 - xi) ** 2 / 2 - 1 / 6 - 2 / math.pi ** 2 * s)
+
+    pts = output.read_vertices(root / "fem" / "vertices.txt")
+    for r in recs[1:]:
+        assert r["friction_stick_nodes"] == 0 and r["friction_slip_nodes"] == r["contact_active_nodes"] > 50
+        assert all(r[k_] < 1e-8 for k_ in KKT)
+    assert recs[0]["friction_work"] < 1e-9 * recs[-1]["friction_work"]      # no slip while pressing
+    last = recs[-1]
+    t = last["load_factor"] - 1.0                                           # s of drag
+    assert last["friction_work"] == pytest.approx(1.0e6 * 0.04 * 0.05, rel=1e-6)   # tau x width x drag, J/m
+    assert last["thermal_energy_change"] == pytest.approx(q * 0.04 * t, rel=1e-6)
+    T = output.read_array(root / "fem" / "inc-0011" / "T.node.txt") - 293.15
+    exact = rise(pts[:, 1], t)
+    face = rise(0.0, t)
+    assert face == pytest.approx(2.5679, rel=1e-4)                          # K: the closed form itself
+    assert np.abs(T - exact).max() < 5e-3 * face
+    bottom, top = pts[:, 1] < 1e-12, pts[:, 1] > L - 1e-12
+    # the profile, not only the mean: the face-to-back difference q L / (2 k) (1 - small transient)
+    assert T[bottom].mean() - T[top].mean() == pytest.approx(face - rise(L, t), rel=1e-2)
