@@ -354,3 +354,76 @@ def test_insulated_thin_strip_warms_as_the_1d_closed_form(tmp_path):
     bottom, top = pts[:, 1] < 1e-12, pts[:, 1] > L - 1e-12
     # the profile, not only the mean: the face-to-back difference q L / (2 k) (1 - small transient)
     assert T[bottom].mean() - T[top].mean() == pytest.approx(face - rise(L, t), rel=1e-2)
+
+
+def test_stl_sphere_reproduces_the_analytic_ball(tmp_path):
+    # A sphere (R = 1 m) meshed by gmsh into a binary STL (10 mm triangles near the pole, 2,870 in all) pressed
+    # 10 mm into the block of stl-ball.toml, against the analytic ball through the same module (gap and
+    # normal in the current configuration), same mesh: the facets lie inside the sphere by at most
+    # e^2 / (8 R) = 1.25e-5 m, 0.125% of the approach, so the force is lower by about 1.5 x that (measured
+    # 0.20%; tolerance 0.5%); the same active nodes, node pressures within 3% of the peak (measured 1.3%),
+    # the contact radius within the Hertz test's 2% (measured 0.58% STL, 0.64% ball).
+    from wendel.results import vtu as output
+    from wendel.scene import stl
+
+    path = stl.sphere(tmp_path / "sphere.stl", fine=0.01)
+    tool_line = 'tool = { stl = "workflows/tools/sphere-r1.stl" }'
+    scenes = {"stl": variant(tmp_path, "stl-ball", {tool_line: f'tool = {{ stl = "{path}" }}'})}
+    (tmp_path / "ball").mkdir()
+    scenes["ball"] = variant(tmp_path / "ball", "stl-ball", {
+        'obstacle = "tool"\n' + tool_line: 'obstacle = "ball"\nfriction = { law = "none" }'})
+    last, p = {}, {}
+    for name, scene in scenes.items():
+        root = run(scene, out=tmp_path / name / "run", png=False, progress=lambda *_: None)
+        last[name] = json.loads((root / "summary.json").read_text())["last_increment"]
+        p[name] = output.read_array(root / "fem" / "inc-0001" / "contact_pressure.node.txt")
+        assert last[name]["error_contact_size"] < 0.02 and all(last[name][k] < 1e-8 for k in KKT)
+    assert len(stl.read(path)) > 2000
+    assert last["stl"]["contact_force"] == pytest.approx(last["ball"]["contact_force"], rel=5e-3)
+    assert last["stl"]["contact_force"] < last["ball"]["contact_force"]        # the facets are inside the sphere
+    assert last["stl"]["contact_active_nodes"] == last["ball"]["contact_active_nodes"] > 50
+    assert np.abs(p["stl"] - p["ball"]).max() < 0.03 * p["ball"].max()
+
+
+def test_bad_stl_tool_is_named(tmp_path):
+    import subprocess
+    import sys
+
+    from wendel.scene import load, stl
+
+    good = stl.read(WORKFLOWS / "tools" / "sphere-r1.stl")
+    tool_line = 'tool = { stl = "workflows/tools/sphere-r1.stl" }'
+
+    def scene_with(name: str, text: bytes | None) -> Path:
+        f = tmp_path / name
+        if text is not None:
+            f.write_bytes(text)
+        (tmp_path / name.replace(".", "-")).mkdir()
+        return variant(tmp_path / name.replace(".", "-"), "stl-ball", {tool_line: f'tool = {{ stl = "{f}" }}'})
+
+    def ascii_stl(tris) -> bytes:
+        rows = ["solid t"] + [f"facet normal 0 0 0\nouter loop\n" + "".join(f"vertex {x} {y} {z}\n" for x, y, z in t)
+                              + "endloop\nendfacet" for t in tris] + ["endsolid t"]
+        return "\n".join(rows).encode()
+
+    cases = {"missing.stl": (None, "no such STL file"),
+             "open.stl": (ascii_stl(good[1:]), "not a closed surface"),
+             "text.stl": (b"hello world\n", "not an STL file")}
+    nan = ascii_stl(good).decode().split("\n")
+    k = next(i for i, line in enumerate(nan) if line.startswith("vertex"))
+    nan[k] = "vertex nan 0 0"
+    cases["nan.stl"] = ("\n".join(nan).encode(), "not finite")
+    for name, (text, message) in cases.items():
+        scene = scene_with(name, text)
+        with pytest.raises(Exception, match=message) as err:
+            load(scene)
+        assert "contact.tool.stl" in str(err.value) and name in str(err.value)
+    # the command line: exit 2, the key and the file named, no traceback
+    proc = subprocess.run([sys.executable, "-m", "wendel.cli", "check", str(scene_with("open2.stl", ascii_stl(good[:-1])))],
+                          capture_output=True, text=True)
+    out = proc.stderr + proc.stdout
+    assert proc.returncode == 2 and "contact.tool.stl" in out and "open2.stl" in out and "Traceback" not in proc.stderr
+    # an inward-oriented surface is turned around: the same outward normals and bounding spheres
+    a, b = stl.table(good[:, ::-1], "in"), stl.table(good, "out")
+    assert np.allclose(a[:, 9:12], b[:, 9:12]) and np.allclose(a[:, 30:], b[:, 30:])
+    assert (np.einsum("ij,ij->i", b[:, 9:12], b[:, 30:33] - [0, 0, 1]) > 0).all()   # out of the sphere

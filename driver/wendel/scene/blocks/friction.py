@@ -10,11 +10,15 @@ edp/lib/tool.idp; contact.py composes them into its table).
 from __future__ import annotations
 
 import math
+from pathlib import Path
 from typing import Optional
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
+from .. import stl
 from . import choice
+
+ROOT = Path(__file__).resolve().parents[4]
 
 FRICTION_LAWS = {"none": 0, "coulomb": 1, "tresca": 2}
 """Friction law name -> ``-fric_law`` id of friction.idp."""
@@ -43,16 +47,34 @@ class Friction(BaseModel):
 
 
 class Tool(BaseModel):
-    """A rigid 2D tool: a counter-clockwise polygon at load factor 0 whose corners are rounded by radii
-    (a cutting tool: rake face, flank face and the edge radius at their corner)."""
+    """A rigid tool at load factor 0: in 2D a counter-clockwise polygon whose corners are rounded by radii
+    (a cutting tool: rake face, flank face and the edge radius at their corner); in 3D a closed triangulated
+    surface from an STL file (validated by wendel.scene.stl: closed, oriented, finite)."""
 
     model_config = ConfigDict(extra="forbid", validate_assignment=True)
 
-    vertices: list[list[float]] = Field(..., description="polygon vertices [[x, y], ...], counter-clockwise [m]")
+    vertices: Optional[list[list[float]]] = Field(None, description="2D: polygon vertices [[x, y], ...], counter-clockwise [m]")
     radii: Optional[list[float]] = Field(None, description="corner radius of each vertex, 0 = sharp [m]; default all 0")
+    stl: Optional[str] = Field(None, description="3D: a closed surface as an STL file (ASCII or binary, coordinates in m at "
+                                                 "load factor 0), relative to the repository root")
+
+    @property
+    def stl_path(self) -> Path:
+        p = Path(self.stl or "")
+        return p if p.is_absolute() else ROOT / p
 
     @model_validator(mode="after")
     def _shape(self):
+        if (self.vertices is None) == (self.stl is None):
+            raise ValueError("contact.tool needs either vertices (a 2D polygon) or stl (a 3D surface), not both")
+        if self.stl is not None:
+            if self.radii is not None:
+                raise ValueError("contact.tool.radii belong to a polygon (vertices), not to an STL surface")
+            try:
+                stl.table(stl.read(self.stl_path), str(self.stl_path))
+            except ValueError as e:
+                raise ValueError(f"contact.tool.stl: {e}") from None
+            return self
         v = self.vertices
         if len(v) < 3 or any(len(p) != 2 for p in v):
             raise ValueError("contact.tool.vertices: at least 3 points [x, y]")
@@ -110,7 +132,9 @@ def friction_options(block, files) -> list[str]:
         p = files.tables / "tool_path.txt"
         p.write_text(f"{len(rows)}\n" + "".join(" ".join(repr(float(v)) for v in r) + "\n" for r in rows))
         opts += ["-tool_path", str(p)]
-    if block.tool is not None:
+    if block.tool is not None and block.tool.stl is not None:
+        opts += ["-tool_stl", str(stl.write_table(block.tool.stl_path, files.tables / "tool_triangles.txt"))]
+    elif block.tool is not None:
         v = block.tool.vertices
         radii = block.tool.radii or [0.0] * len(v)
         p = files.tables / "tool_polygon.txt"
