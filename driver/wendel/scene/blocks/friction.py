@@ -88,7 +88,8 @@ class Tool(BaseModel):
 
 class ToolPath(BaseModel):
     """The tool's rigid motion as piecewise-linear functions of the load factor (extrapolated linearly past
-    the ends): translation (x, y) and rotation about contact.center; added to contact.displacement."""
+    the ends): translation (x, y, z) and rotation about the axis through contact.center (2D: z); added to
+    contact.displacement."""
 
     model_config = ConfigDict(extra="forbid", validate_assignment=True)
 
@@ -96,7 +97,8 @@ class ToolPath(BaseModel):
     x: Optional[list[float]] = Field(None, description="translation along x at those load factors [m]; default 0")
     y: Optional[list[float]] = Field(None, description="translation along y at those load factors [m]; default 0")
     z: Optional[list[float]] = Field(None, description="translation along z at those load factors (3D) [m]; default 0")
-    angle: Optional[list[float]] = Field(None, description="rotation about contact.center, counter-clockwise (2D) [deg]; default 0")
+    angle: Optional[list[float]] = Field(None, description="rotation about the axis through contact.center, counter-clockwise [deg]; default 0")
+    axis: Optional[list[float]] = Field(None, description="the rotation axis [ax, ay, az] (3D; normalised) [1]; default [0, 0, 1] (2D: z only)")
 
     @model_validator(mode="after")
     def _lengths(self):
@@ -107,6 +109,8 @@ class ToolPath(BaseModel):
             val = getattr(self, key)
             if val is not None and len(val) != n:
                 raise ValueError(f"contact.path.{key} needs {n} values (one per load factor)")
+        if self.axis is not None and (len(self.axis) != 3 or not math.hypot(*self.axis) > 1e-12):
+            raise ValueError("contact.path.axis: three components [ax, ay, az], not all zero")
         return self
 
     def rows(self) -> list[tuple[float, float, float, float, float]]:
@@ -132,6 +136,9 @@ def friction_options(block, files) -> list[str]:
         p = files.tables / "tool_path.txt"
         p.write_text(f"{len(rows)}\n" + "".join(" ".join(repr(float(v)) for v in r) + "\n" for r in rows))
         opts += ["-tool_path", str(p)]
+        if block.path.axis is not None:
+            a = block.path.axis
+            opts += ["-tool_axis_x", repr(float(a[0])), "-tool_axis_y", repr(float(a[1])), "-tool_axis_z", repr(float(a[2]))]
     if block.tool is not None and block.tool.stl is not None:
         opts += ["-tool_stl", str(stl.write_table(block.tool.stl_path, files.tables / "tool_triangles.txt"))]
     elif block.tool is not None:
