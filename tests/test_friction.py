@@ -314,7 +314,7 @@ def test_friction_bench_at_smoke_sizes(tmp_path):
     # friction costs Newton iterations, but not many more than the frictionless solve (measured 1.5x on Hertz)
     assert by[("hertz", "Coulomb mu = 0.3")]["iterations_vs_frictionless"] <= 2.0
     # the Coulomb sliding block near the aim of 1.5x (the first sets of an increment predicted, friction.idp):
-    # 17 / 11 = 1.55 at this smoke size (18 / 12 = 1.5 at full size; 1.83x before the prediction)
+    # 17 / 11 = 1.55 at this smoke size (18 / 11 = 1.64 at full size; 22 / 12 = 1.83 before the prediction)
     assert by[("sliding-block", "Coulomb mu = 0.3")]["iterations_vs_frictionless"] <= 1.6
     stl_row, ball_row = by[("stl-ball", "STL sphere, frictionless")], by[("stl-ball", "analytic ball, frictionless")]
     assert stl_row["contact_force"] == pytest.approx(ball_row["contact_force"], rel=0.05)    # smoke: coarse
