@@ -12,7 +12,7 @@ APT_TEST_PACKAGES := slurmctld slurmd slurm-client slurmdbd munge mariadb-server
 SCENE ?= workflows/smoke.toml
 
 .PHONY: setup run test bench clean
-setup: build/.apt-ok $(VENV)/.ok build/plugins/MUMPS_mpi.so build/plugins/wendel_petsc.so
+setup: build/.apt-ok $(VENV)/.ok build/plugins/MUMPS_mpi.so build/plugins/wendel_petsc.so build/plugins/wendel_tool.so
 
 # Debian packages: FreeFEM, Open MPI, OpenBLAS under FreeFEM's direct solvers, Mesa for off-screen pictures.
 build/.apt-ok: Makefile scripts/apt-ensure.sh
@@ -39,6 +39,11 @@ build/plugins/wendel_petsc.so: edp/plugins/wendel_petsc.cpp build/.apt-ok
 	g++ -shared -fPIC -O2 -Wall -Wno-unused-variable -Wno-sign-compare -Wno-mismatched-new-delete -isystem /usr/include/freefem++ -isystem $(PETSC_DIR)/include \
 	  -I/usr/lib/x86_64-linux-gnu/openmpi/include -DOMPI_SKIP_MPICXX $< -o $@ \
 	  -L$(PETSC_DIR)/lib -Wl,-rpath,$(PETSC_DIR)/lib -lpetsc_real -lmpi
+
+# wendel's tool plugin (lib/tool.idp): signed distance to a closed triangulated surface (an STL tool).
+build/plugins/wendel_tool.so: edp/plugins/wendel_tool.cpp build/.apt-ok
+	@mkdir -p build/plugins
+	g++ -shared -fPIC -O2 -Wall -Wno-unused-variable -Wno-sign-compare -Wno-mismatched-new-delete -isystem /usr/include/freefem++ $< -o $@
 
 run: setup
 	$(VENV)/bin/wendel run $(SCENE)
