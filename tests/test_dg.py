@@ -58,7 +58,8 @@ def test_a_penalty_below_the_stability_bound_is_warned_about_and_spoils_the_solu
 
 
 @pytest.mark.parametrize("change, message", [
-    (("[discretization]", "[plasticity]\nsigma0 = 1.0\n\n[discretization]"), "elastic scenes only; remove [plasticity]"),
+    (("[discretization]", "[thermal]\n\n[discretization]"), "elastic and plastic scenes only; remove [thermal]"),
+    (("[discretization]", "[plasticity]\nsigma0 = 1.0\n\n[discretization]"), "kind = 'dg' with [plasticity] needs"),
     (("solver = \"direct\"", "solver = \"ffddm\""), "numerics.solver = 'direct'"),
     (("order = 1                # P1dc", "order = 3"), "discretization.order"),
     (("gamma_mu = 20.0 ", "gamma_mu = -1.0 "), "discretization.gamma_mu"),
@@ -70,3 +71,75 @@ def test_what_dg_does_not_join_is_refused_when_the_scene_is_read(scene_file, cha
     with pytest.raises(SceneError) as err:
         load(path)
     assert message in str(err.value) and str(path) in str(err.value)
+
+
+def test_cook_membrane_dg_does_not_lock_where_cg_p1_does(tmp_path, quiet):
+    # nu = 0.499975, h = 4 m (measured: CG P1 9.96, DG P1 15.19, DG P2 16.38 against Krysl's 16.4326)
+    from wendel.bench.dg import COOK_REFERENCE, _run
+
+    tips = {m: _run(WORKFLOWS / "cook-dg.toml", m, 4.0, tmp_path / m)["record"]["probe_uy"] for m in ("cg1", "dg1", "dg2")}
+    err = {m: abs(t / COOK_REFERENCE - 1) for m, t in tips.items()}
+    assert err["cg1"] > 0.3, tips                # locked
+    assert err["dg2"] < 0.01, tips
+    assert err["dg1"] < err["cg1"] / 4, tips
+
+
+def test_dg_and_cg_agree_on_step8_and_both_fields_are_written(tmp_path):
+    from wendel.bench.dg import _step8
+
+    rows = _step8(True, tmp_path)
+    assert [r["method"] for r in rows] == ["cg1", "dg1"]
+    cg, dg = rows
+    assert dg["dofs"] > 5 * cg["dofs"]           # three DoFs per triangle and component, none shared
+    # the two energies differ by less than their distance to the finer CG P2 run (measured 0.07 % and 2 %)
+    assert abs(dg["energy"] / cg["energy"] - 1) < 0.5 * min(cg["error"], dg["error"]), rows
+    assert 0 < dg["max_difference"] < 0.01, rows
+    import meshio
+
+    vtu = meshio.read(tmp_path / "step8-cg-dg.vtu")
+    assert {"u_cg", "u_dg", "u_dg_minus_cg"} <= set(vtu.point_data)
+
+
+def test_dg_plasticity_follows_hill_with_newton_converging_fast(tmp_path, quiet):
+    # Hill's cylinder at its smoke size (h = 0.05 m): measured plastic-radius error 0.101 (DG P1, 3,258 DoFs,
+    # 23 Newton iterations over 6 increments) against 0.207 for CG P1 (630 DoFs, 22 iterations)
+    from test_entry import MODULES, compiled
+
+    found, switches, _ = compiled(tmp_path / "entry", "cylinder-dg.toml")
+    assert found & set(MODULES) == {"dg", "plasticity"} and "-DPk=P1dc" in switches
+    dg = run(WORKFLOWS / "cylinder-dg.toml", smoke=True, out=tmp_path / "dg", png=False, progress=quiet)
+    cg = run(WORKFLOWS / "cylinder.toml", smoke=True, out=tmp_path / "cg", png=False, progress=quiet)
+    sd, sc = (json.loads((r / "summary.json").read_text()) for r in (dg, cg))
+    assert sd["increments"] == sc["increments"] == 6
+    assert sd["newton_iterations"] <= 30, sd["newton_iterations"]        # the consistent tangent on the faces too
+    err_dg = sd["errors"]["error_plastic_radius"]
+    assert 0 < err_dg < 0.15 and err_dg < sc["errors"]["error_plastic_radius"], (sd["errors"], sc["errors"])
+
+
+def test_a_killed_dg_plastic_run_resumes_to_the_same_result(tmp_path):
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    import numpy as np
+
+    cmd = [sys.executable, "-m", "wendel.cli", "run"]
+    scene = str(WORKFLOWS / "cylinder-dg.toml")
+    assert subprocess.run(cmd + [scene, "--smoke", "--out", str(tmp_path / "ref")], capture_output=True).returncode == 0
+    killed = tmp_path / "killed"
+    p = subprocess.Popen(cmd + [scene, "--smoke", "--out", str(killed)], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    while p.poll() is None and not (killed / "fem" / "inc-0003" / "done").is_file():
+        time.sleep(0.005)
+    assert p.poll() is None, "the run ended before its third increment"
+    p.send_signal(signal.SIGKILL)
+    p.wait()
+    r = subprocess.run(cmd + ["--resume", str(killed)], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    rows = [list(csv.DictReader((run_dir / "history.csv").open())) for run_dir in (tmp_path / "ref", killed)]
+    assert [r_["newton_iterations"] for r_ in rows[0]] == [r_["newton_iterations"] for r_ in rows[1]]
+    for a, b in zip(*rows):
+        for key in ("strain_energy", "max_displacement", "max_plastic_strain"):
+            assert float(a[key]) == pytest.approx(float(b[key]), rel=1e-9), (key, a, b)
+    last = lambda d: sorted((d / "fem").glob("inc-*/u_dg.qp.txt"))[-1].read_text().split()
+    np.testing.assert_allclose(np.array(last(tmp_path / "ref"), float), np.array(last(killed), float), rtol=1e-9, atol=1e-14)

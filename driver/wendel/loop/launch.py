@@ -85,6 +85,8 @@ def options(scene: Scene, files: RunFiles, dimension: int, segment: dict | None 
     v = list(bf.value) + [0.0] * (3 - len(bf.value))
     opts += ["-body_id", str(BODY_FORCES[bf.kind]), "-body_fx", repr(v[0]), "-body_fy", repr(v[1]),
              "-body_fz", repr(v[2])]
+    if scene.reference.probe:
+        opts += [v for a, c in zip("xyz", scene.reference.probe) for v in (f"-probe_{a}", repr(float(c)))]
     if scene.reference.analytic:
         opts += ["-ref_id", str(ANALYTIC_REFERENCES[scene.reference.analytic])]
     for name in scene.blocks:

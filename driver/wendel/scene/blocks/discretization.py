@@ -49,12 +49,16 @@ def penalty_warnings(block: Discretization, dimension: int) -> list[str]:
 
 
 def check(block: Discretization, scene) -> None:
-    """DG joins nothing else yet: 2D plane elastic scenes, direct solver, no remesh, no prescribed motion."""
+    """DG joins plasticity (P1) only: 2D plane scenes, direct solver, no remesh, no prescribed motion."""
     if block.kind != "dg":
         return
-    others = [n for n in scene.blocks if n != "discretization"]
+    others = [n for n in scene.blocks if n not in ("discretization", "plasticity")]
     if others:
-        raise ValueError(f"discretization.kind = 'dg' is implemented for elastic scenes only; remove [{others[0]}]")
+        raise ValueError(f"discretization.kind = 'dg' is implemented for elastic and plastic scenes only; "
+                         f"remove [{others[0]}]")
+    if getattr(scene, "plasticity", None) is not None and block.order != 1:
+        raise ValueError("discretization.kind = 'dg' with [plasticity] needs discretization.order = 1 (the face "
+                         "stress is the element's one-point stress)")
     g = scene.geometry
     if g.builder == "box" or g.dimension == 3:
         raise ValueError("discretization.kind = 'dg' is 2D only (FreeFEM 4.9's intallfaces does not see the "
