@@ -143,3 +143,56 @@ def test_a_killed_dg_plastic_run_resumes_to_the_same_result(tmp_path):
             assert float(a[key]) == pytest.approx(float(b[key]), rel=1e-9), (key, a, b)
     last = lambda d: sorted((d / "fem").glob("inc-*/u_dg.qp.txt"))[-1].read_text().split()
     np.testing.assert_allclose(np.array(last(tmp_path / "ref"), float), np.array(last(killed), float), rtol=1e-9, atol=1e-14)
+
+
+@pytest.mark.parametrize("h", [0.1, 0.07])
+def test_the_notched_plate_separates_across_its_ligament_and_the_force_drops(tmp_path, scene_file, quiet, h):
+    # measured: h = 0.1 m: 1 face open at load factor 0.4 (the notch tip), 39 at 0.5, the force from 1.69e8 to
+    # 3.6e7 N/m; h = 0.07 m: 35 faces at 0.4, the force from 1.27e8 to 2.8e7, then 0 (fully apart) at 0.5
+    import numpy as np
+
+    from wendel.results.vtu import read_array, read_mesh
+
+    text = edit((WORKFLOWS / "dg-separation.toml").read_text(), "h = 0.1                  # m", f"h = {h}  # m")
+    root = run(scene_file(text), smoke=True, out=tmp_path / "run", png=False, progress=quiet)
+    recs = [json.loads((d / "record.json").read_text()) for d in sorted((root / "fem").glob("inc-*"))]
+    force = [r["dg_reaction_y"] for r in recs]
+    first = next(i for i, r in enumerate(recs) if r["dg_open_faces"] > 0)
+    assert recs[first - 1]["load_factor"] >= 0.3                    # elastic and intact up to 120 MPa nominal
+    peak = max(force)
+    assert force[-1] < 0.3 * peak and min(force[first:]) < 0.3 * peak, force
+    assert all(r["dg_open_faces"] >= p["dg_open_faces"] for p, r in zip(recs, recs[1:]))     # for good
+    points, cells = read_mesh(root / "mesh.msh", 2)
+    centre = points[cells].mean(axis=1)
+    opened = read_array(root / "fem" / f"inc-{len(recs):04d}" / "dg_open.cell.txt") > 0
+    near = np.abs(centre[opened, 1] - 1.0) < 0.3                     # the ligament behind the notch tip at y = 1
+    assert near.mean() > 0.9, centre[opened]
+    assert centre[opened, 0].min() < 0.3 and centre[opened, 0].max() > 0.9   # from the tip to the far edge
+
+
+def test_a_killed_separating_run_resumes_to_the_same_result(tmp_path):
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    cmd = [sys.executable, "-m", "wendel.cli", "run"]
+    scene = str(WORKFLOWS / "dg-separation.toml")
+    assert subprocess.run(cmd + [scene, "--smoke", "--out", str(tmp_path / "ref")], capture_output=True).returncode == 0
+    killed = tmp_path / "killed"
+    p = subprocess.Popen(cmd + [scene, "--smoke", "--out", str(killed)], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    while p.poll() is None and not (killed / "fem" / "inc-0004" / "done").is_file():    # one face open
+        time.sleep(0.005)
+    assert p.poll() is None, "the run ended before its fourth increment"
+    p.send_signal(signal.SIGKILL)
+    p.wait()
+    r = subprocess.run(cmd + ["--resume", str(killed)], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    recs = [[json.loads((d / "record.json").read_text()) for d in sorted((run_dir / "fem").glob("inc-*"))]
+            for run_dir in (tmp_path / "ref", killed)]
+    assert [(r_["newton_iterations"], r_["dg_open_faces"]) for r_ in recs[0]] == \
+        [(r_["newton_iterations"], r_["dg_open_faces"]) for r_ in recs[1]]
+    for a, b in zip(*recs):
+        assert a["dg_reaction_y"] == pytest.approx(b["dg_reaction_y"], rel=1e-8, abs=1e-3)
+    assert (tmp_path / "ref" / "fem" / "inc-0010" / "dg_open.edge.txt").read_text() == \
+        (killed / "fem" / "inc-0010" / "dg_open.edge.txt").read_text()

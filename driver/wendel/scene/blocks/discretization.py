@@ -36,6 +36,8 @@ class Discretization(BaseModel):
                             "sufficient: 6 (P1), 18 (P2) in 2D")
     gamma_lambda: float = Field(20.0, gt=0, le=1e6, description="penalty on the normal jump, times lambda "
                                 "|F|/|K| [1]; same bound")
+    separation_stress: float = Field(0.0, ge=0, le=1e15, description="dg: an interior face whose normal stress "
+                                     "(mean of its two elements) exceeds this opens for good [Pa]; 0 = never")
 
 
 def penalty_warnings(block: Discretization, dimension: int) -> list[str]:
@@ -51,6 +53,8 @@ def penalty_warnings(block: Discretization, dimension: int) -> list[str]:
 def check(block: Discretization, scene) -> None:
     """DG joins plasticity (P1) only: 2D plane scenes, direct solver, no remesh, no prescribed motion."""
     if block.kind != "dg":
+        if block.separation_stress > 0:
+            raise ValueError("discretization.separation_stress needs discretization.kind = 'dg'")
         return
     others = [n for n in scene.blocks if n not in ("discretization", "plasticity")]
     if others:
@@ -80,7 +84,7 @@ def options(block: Discretization, scene, files) -> list[str]:
     if block.kind != "dg":
         return []
     return ["-dg_gamma_mu", repr(block.gamma_mu), "-dg_gamma_lambda", repr(block.gamma_lambda),
-            "-dg_order", str(block.order)]
+            "-dg_order", str(block.order), "-dg_sep_stress", repr(block.separation_stress)]
 
 
 def macros(scene) -> list[str]:
