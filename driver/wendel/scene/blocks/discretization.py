@@ -65,8 +65,8 @@ def check(block: Discretization, scene) -> None:
                          "stress is the element's one-point stress)")
     g = scene.geometry
     if g.builder == "box" or g.dimension == 3:
-        raise ValueError("discretization.kind = 'dg' is 2D only (FreeFEM 4.9's intallfaces does not see the "
-                         "neighbour element in 3D)")
+        raise ValueError("discretization.kind = 'dg' is 2D only (FreeFEM 4.9's intallfaces has no jump in linear "
+                         "forms, the residual, in 3D)")
     if scene.elasticity.plane == "axisymmetric" or scene.elasticity.order != 1:
         raise ValueError("discretization.kind = 'dg' needs elasticity.plane = 'strain' or 'stress' and "
                          "elasticity.order = 1 (the DG degree is discretization.order)")
