@@ -12,6 +12,7 @@ import math
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from wendel.loop import run
 from wendel.results import vtu as output
@@ -29,24 +30,76 @@ def increments(root: Path):
     return out
 
 
-def test_frictionless_compression_of_a_cylinder_to_half_height(scene_file, tmp_path, quiet):
-    """50 % height in 10 increments: log strain ln(h / h0) axially and ln(r / r0) / -2 radially and in hoop
-    (1e-12); Cauchy stress on sigma = sigma0 + E H / (E + H) (|eps| - sigma0 / E) (1e-10); radial and hoop
-    stresses 0; the platen force equals sigma_y(eps) times the current area pi r^2 (1e-10)."""
-    E, H, s0 = 70e9, 1e9, 250e6
+VOCE = """[plasticity]
+law = "voce"
+sigma0 = 450e6
+H = 129.24e6
+voce_sigma_inf = 715e6
+voce_delta = 16.93
+"""
+
+
+def uniaxial_stress(e: float, E: float, law) -> float:
+    """|sigma| of uniaxial stress at log strain |e| (hypoelastic in log strain, so exact): E (|e| - p) = sigma_y(p)."""
+    if E * e <= law(0.0)[0]:
+        return E * e
+    p = 0.0
+    for _ in range(100):                 # Newton on g(p) = E (e - p) - sigma_y(p), decreasing
+        sy, dsy = law(p)
+        g = E * (e - p) - sy
+        p += g / (E + dsy)
+        if abs(g) < 1e-6:                # Pa
+            break
+    return law(p)[0]
+
+
+@pytest.mark.parametrize("hardening", ["linear", "voce"])
+def test_frictionless_compression_of_a_cylinder_to_half_height(scene_file, tmp_path, quiet, hardening):
+    """50 % height in 10 increments: log strain ln(h / h0) axially and ln(r / r0) radially and in hoop
+    (1e-12); Cauchy stress on the uniaxial closed form (linear hardening sigma0 + H p, or Voce saturation
+    sigma0 + H p + (sigma_inf - sigma0)(1 - exp(-delta p)), with the necking bar's data) to 1e-10; radial and
+    hoop stresses 0; the platen force equals sigma_y(eps) times the current area pi r^2 (1e-10)."""
     text = (WORKFLOWS / "ul-compression-axi.toml").read_text()
+    if hardening == "linear":
+        E = 70e9
+        law = lambda p: (250e6 + 1e9 * p, 1e9)                          # noqa: E731
+    else:
+        E = 206.9e9
+        text = text.replace("E = 70e9 ", "E = 206.9e9 ").replace("nu = 0.3 ", "nu = 0.29 ")
+        text = text[:text.index("[plasticity]")] + VOCE + text[text.index("[kinematics]"):]
+        law = lambda p: (450e6 + 129.24e6 * p + 265e6 * (1 - math.exp(-16.93 * p)),   # noqa: E731
+                         129.24e6 + 265e6 * 16.93 * math.exp(-16.93 * p))
     root = run(scene_file(text, "c.toml"), smoke=True, out=tmp_path / "c", progress=quiet, png=False)
     incs = increments(root)
     assert len(incs) == 10
     for rec, cells, pos in incs:
         e = math.log(1 - 0.5 * rec["load_factor"])
-        ref = -(s0 + E * H / (E + H) * (abs(e) - s0 / E))
+        ref = -uniaxial_stress(abs(e), E, law)
         r = pos[:, 0].max()
         assert np.abs(cells["strain_yy"] - e).max() < 1e-12
         assert np.abs(cells["strain_hoop"] - math.log(r)).max() < 1e-12         # r0 = 1 m
         assert np.abs(cells["strain_xx"] - math.log(r)).max() < 1e-12
         assert np.abs(cells["stress_yy"] / ref - 1).max() < 1e-10, (rec["increment"], cells["stress_yy"].mean(), ref)
+        assert np.abs(cells["sigma_y"] / ref + 1).max() < 1e-10
         for k in ("stress_xx", "stress_zz", "stress_xy"):              # radial, hoop, shear
             assert np.abs(cells[k]).max() < 1e-10 * abs(ref)
         assert abs(rec["reaction_y_4"] / (ref * math.pi * r ** 2) - 1) < 1e-10
-    assert abs(np.ptp(incs[-1][2][:, 1]) - 0.5) < 1e-12 and incs[-1][2][:, 0].max() > 1.41       # h = h0 / 2, r ~ sqrt 2
+    assert abs(np.ptp(incs[-1][2][:, 1]) - 0.5) < 1e-12 and incs[-1][2][:, 0].max() > 1.41   # h = h0 / 2, r ~ sqrt 2
+
+
+@pytest.mark.parametrize("table, words", [
+    ('law = "voce"\nsigma0 = 450e6\n', "needs voce_sigma_inf >= sigma0"),
+    ('law = "voce"\nsigma0 = 450e6\nvoce_sigma_inf = 400e6\n', "needs voce_sigma_inf >= sigma0"),
+    ('law = "voce"\nsigma0 = 450e6\nvoce_sigma_inf = 715e6\nvoce_delta = -1.0\n', "voce_delta"),
+])
+def test_bad_voce_tables_are_refused_by_the_scene_check(scene_file, table, words):
+    """`wendel check` exits 2 naming the key (no traceback)."""
+    import subprocess
+    import sys
+
+    text = (WORKFLOWS / "ul-compression-axi.toml").read_text()
+    text = text[:text.index("[plasticity]")] + "[plasticity]\n" + table + "\n" + text[text.index("[kinematics]"):]
+    out = subprocess.run([sys.executable, "-m", "wendel.cli", "check", str(scene_file(text))],
+                         capture_output=True, text=True)
+    assert out.returncode == 2, out.stdout + out.stderr
+    assert words in out.stdout + out.stderr and "Traceback" not in out.stderr
