@@ -148,9 +148,11 @@ def image_size(path: Path) -> tuple[int, int]:
 
 def in_current_configuration(block: Contact, scene) -> bool:
     """Gap and normal in the current configuration (edp/lib/friction.idp, ``-DWITHFRICTION=1``): friction, a tool,
-    a path or force control; and any plane or ball obstacle of an updated-Lagrangian scene (without friction:
-    law none), whose body moves far from the launch mesh between remeshes."""
-    ul = scene is not None and scene.kinematics.updated_lagrangian and block.obstacle in ("plane", "ball", "tool")
+    a path or force control; and any plane or ball obstacle of a plane or 3D updated-Lagrangian scene (without
+    friction: law none), whose body moves far from the launch mesh between remeshes (friction.idp has no
+    (r, z) weights: axisymmetric scenes keep contact.idp)."""
+    ul = scene is not None and scene.kinematics.updated_lagrangian and block.obstacle in ("plane", "ball", "tool") \
+        and scene.elasticity.plane != "axisymmetric"
     return block.current_configuration or ul
 
 
