@@ -12,6 +12,7 @@ from ..meshes import LABELS
 from ..scene import petsc
 from ..scene import axisymmetric
 from ..scene.blocks import BLOCKS, PROBLEMS, discretization
+from ..scene.blocks.contact import in_current_configuration
 from ..scene.schema import ANALYTIC_REFERENCES, BODY_FORCES, Scene
 from .checkpoint import RunFiles
 
@@ -53,7 +54,7 @@ def macros(scene: Scene, dimension: int) -> list[str]:
     switches += axisymmetric.macros(scene, dimension)
     if scene.kinematics.updated_lagrangian:
         switches.append("-DUPDATEDLAGRANGIAN=1")     # edp/lib/kinematics.idp
-    if getattr(scene, "contact", None) is not None and scene.contact.current_configuration:
+    if getattr(scene, "contact", None) is not None and in_current_configuration(scene.contact, scene):
         switches.append("-DWITHFRICTION=1")      # friction, tool, path or force control: edp/lib/friction.idp
     if scene.numerics.solver == "petsc":
         switches.append("-DWITHPETSC=1")       # loads wendel's PETSc plugin (lib/petsc.idp)

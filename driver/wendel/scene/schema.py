@@ -207,8 +207,8 @@ class Numerics(Strict):
 
 class Kinematics(Strict):
     """Small strain on the mesh of the last remesh, or updated-Lagrangian large deformation
-    (edp/lib/kinematics.idp: incremental logarithmic strain, polar rotation of the increment; 2D plane strain or
-    3D, P1)."""
+    (edp/lib/kinematics.idp: incremental logarithmic strain, polar rotation of the increment; 2D plane strain,
+    axisymmetric (r, z) or 3D, P1)."""
 
     kind: KinematicsName = Field("small-strain", description=f"one of {', '.join(KINEMATICS)}")
     min_area_ratio: float = Field(0.02, ge=0, lt=1, description="updated-Lagrangian: an increment that shrinks "
@@ -343,8 +343,9 @@ class SceneBase(Strict):
                 raise ValueError("kinematics.kind = \"updated-lagrangian\" is for mechanics scenes")
             if getattr(self, "thermal", None) is not None:
                 raise ValueError("kinematics.kind = \"updated-lagrangian\" is not implemented with [thermal]")
-            if self.elasticity.plane != "strain":
-                raise ValueError("kinematics.kind = \"updated-lagrangian\" needs elasticity.plane = \"strain\"")
+            if self.elasticity.plane == "stress":
+                raise ValueError("kinematics.kind = \"updated-lagrangian\" needs elasticity.plane = \"strain\" "
+                                 "or \"axisymmetric\"")
         elif self.kinematics.initial_strain != [0.0, 0.0, 0.0]:
             raise ValueError("kinematics.initial_strain needs kinematics.kind = \"updated-lagrangian\"")
         if self.body_force.kind == "manufactured" and self.reference.analytic is None:
