@@ -438,6 +438,11 @@ class Process:
             plots(root, rows, self.probes, self.profiles)
         self.progress(f"  heat in {heat_in:.4g} J = stored {d_energy:.4g} + chips {chips:.4g} - convection {conv:.4g}"
                       f" - thermoelastic {te:.3g}; mismatch {abs(mismatch) / scale:.2e} (transfer defect {defect:.3g} J)")
-        self.progress(f"  tables in {tables}, pictures and drilling.json in {root}")
+        pics = [n for n in ("probes.png", "bore.png", "energy.png") if (root / n).is_file()]
+        if pics:
+            self.progress(f"  pictures: {', '.join(str(root / n) for n in pics)}")
+        if self.probes:
+            self.progress(f"  probe histories (thermocouples): {tables / 'probes.csv'}")
+        self.progress(f"  per step: {tables / 'drilling-steps.csv'}; all steps and bore profiles: {root / 'drilling.json'}")
 
 
