@@ -432,6 +432,7 @@ class Process:
                            "diameter_error_end_of_drilling": drilled[-1]["diameter_error"] if drilled else [],
                            "hoop_stress_after": last["hoop_stress"], "axial_stress_after": last["axial_stress"]}
         summary["drilling"] = out
+        summary["outputs"] = campaign_outputs(out, self.profiles)
         (root / "summary.json").write_text(json.dumps(summary, indent=1))
         (root / "drilling.json").write_text(json.dumps({**out, "steps": rows, "profiles": self.profiles}, indent=1))
         if self.scene.output.png:
@@ -446,3 +447,21 @@ class Process:
         self.progress(f"  per step: {tables / 'drilling-steps.csv'}; all steps and bore profiles: {root / 'drilling.json'}")
 
 
+
+
+def campaign_outputs(out: dict, profiles: list[dict]) -> dict:
+    """Scalars of a drilling run for a campaign's table (``wendel sweep`` reads summary.json["outputs"]): the peak
+    temperature of each thermocouple (K), the bore diameter error 2 u_r (m; mean over the depth bins and largest
+    magnitude) at the end of drilling and at the end of the run (after cooling), and the energy balance error."""
+    res = {f"peak_T_{name}": v for name, v in out.get("probes_peak", {}).items()}
+    drilled = [p for p in profiles if p["kind"] != "cool"]
+    for label, prof in (("end_of_drilling", drilled[-1] if drilled else None),
+                        ("after_cooling", profiles[-1] if profiles else None)):
+        if prof is None:
+            continue
+        d = np.array(prof["diameter_error"], dtype=float)
+        if np.isfinite(d).any():
+            res[f"bore_diameter_error_{label}"] = float(np.nanmean(d))
+            res[f"bore_diameter_error_max_{label}"] = float(d[np.nanargmax(np.abs(d))])
+    res["energy_balance_error"] = out["energy"]["balance_error"]
+    return res
