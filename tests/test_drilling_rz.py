@@ -101,3 +101,36 @@ def test_rz_drilling_without_removal_keeps_energy_to_1e_6(tmp_path):
     assert e["chips_heat"] == 0.0
     assert e["balance_error"] < 1e-6
     assert e["heat_in"] == pytest.approx(0.3 * 2 * math.pi * 2000.0 / 60 * 1.0 * 0.5, rel=1e-12)
+
+
+def test_killed_drilling_run_resumes_to_the_same_result(tmp_path):
+    """A drilling run killed (SIGKILL, its whole process group) after its second removal step: `wendel run
+    --resume` starts it again in its folder (a drilling run keeps no process checkpoint: the completed steps are
+    recomputed, not kept) and ends with the result of an uninterrupted run."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    from wendel.freefem import ROOT
+
+    extra = "depth = 0.008\nsteps = 4\ncooling = 1e6\ncooling_steps = 1"
+    _, ref = _drill(tmp_path, extra, name="ref")
+    scene = tmp_path / "k.toml"
+    scene.write_text(RZ_SCENE.format(extra=extra))
+    out = tmp_path / "killed"
+    proc = subprocess.Popen([sys.executable, "-m", "wendel.cli", "run", str(scene), "--out", str(out)],
+                            cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+    deadline = time.time() + 120
+    while not (out / "remesh" / "remesh-002.json").is_file() and proc.poll() is None and time.time() < deadline:
+        time.sleep(0.05)
+    assert proc.poll() is None, "the run ended before it could be killed"
+    os.killpg(proc.pid, signal.SIGKILL)
+    proc.wait()
+    assert not (out / "summary.json").is_file() or "drilling" not in json.loads((out / "summary.json").read_text())
+    assert run(None, resume=out, progress=lambda *_: None) == out.resolve()
+    got = json.loads((out / "summary.json").read_text())["drilling"]
+    for k in ("heat_in", "thermal_energy_change", "chips_heat", "convection"):
+        assert got["energy"][k] == pytest.approx(ref["energy"][k], rel=1e-12, abs=1e-12)
+    assert got["bore"]["diameter_error_after"] == pytest.approx(ref["bore"]["diameter_error_after"], rel=1e-9)

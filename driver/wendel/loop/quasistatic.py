@@ -43,8 +43,9 @@ def run(scene_path: str | Path, smoke: bool = False, ranks: int | None = None, o
     """
     if resume is not None:
         root = Path(resume).resolve()
-        if not (root / "checkpoint.json").is_file() and (root / "scene.resolved.json").is_file():
-            return restart(root, progress)
+        if (root / "scene.resolved.json").is_file() and (not (root / "checkpoint.json").is_file()
+                                                       or _drilling(root)):
+            return restart(root, progress)        # a drilling run keeps no process checkpoint: it starts again
         with guarded(root):
             files, scene, state = resume_run(root, progress)
             progress(f"resuming {files.root} after increment {state.last[0]} (load factor {state.last[1]:g})")
@@ -63,6 +64,14 @@ def run(scene_path: str | Path, smoke: bool = False, ranks: int | None = None, o
             scene.numerics.solver = "ffddm"      # first: the schema refuses other solvers on several ranks
         scene.numerics.ranks = ranks
     return run_scene(scene, scene_path, Path(out) if out else _new_run_dir(scene_path, smoke), smoke, progress)
+
+
+def _drilling(root: Path) -> bool:
+    """Whether the run folder holds a drilling run (its resolved scene has a [drilling] table)."""
+    try:
+        return json.loads((root / "scene.resolved.json").read_text()).get("drilling") is not None
+    except (OSError, ValueError):
+        return False
 
 
 def run_scene(scene: Scene, scene_path: Path, out: Path, smoke: bool = False, progress=print) -> Path:
