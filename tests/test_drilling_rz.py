@@ -105,8 +105,8 @@ def test_rz_drilling_without_removal_keeps_energy_to_1e_6(tmp_path):
 
 def test_killed_drilling_run_resumes_to_the_same_result(tmp_path):
     """A drilling run killed (SIGKILL, its whole process group) after its second removal step: `wendel run
-    --resume` starts it again in its folder (a drilling run keeps no process checkpoint: the completed steps are
-    recomputed, not kept) and ends with the result of an uninterrupted run."""
+    --resume` goes on after the last completed step (kept in drilling-state.json; those steps are not computed
+    again) and ends with the result of an uninterrupted run."""
     import os
     import signal
     import subprocess
@@ -123,13 +123,24 @@ def test_killed_drilling_run_resumes_to_the_same_result(tmp_path):
     proc = subprocess.Popen([sys.executable, "-m", "wendel.cli", "run", str(scene), "--out", str(out)],
                             cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
     deadline = time.time() + 120
-    while not (out / "remesh" / "remesh-002.json").is_file() and proc.poll() is None and time.time() < deadline:
-        time.sleep(0.05)
+    state = out / "drilling-state.json"
+    while not (state.is_file() and json.loads(state.read_text())["done"] >= 2) and proc.poll() is None \
+            and time.time() < deadline:
+        time.sleep(0.02)
     assert proc.poll() is None, "the run ended before it could be killed"
     os.killpg(proc.pid, signal.SIGKILL)
     proc.wait()
+    done = json.loads(state.read_text())["done"]
+    assert 2 <= done < 4
     assert not (out / "summary.json").is_file() or "drilling" not in json.loads((out / "summary.json").read_text())
-    assert run(None, resume=out, progress=lambda *_: None) == out.resolve()
+    kept = {d.name: (d / "record.json").stat().st_mtime_ns for d in (out / "fem").glob("inc-*")
+            if int(d.name[4:]) <= done and (d / "record.json").is_file()}
+    assert len(kept) == done
+    said = []
+    assert run(None, resume=out, progress=said.append) == out.resolve()
+    assert any(f"resuming after removal step {done} of 4" in line for line in said)
+    for name, mtime in kept.items():          # the completed steps were not computed again
+        assert (out / "fem" / name / "record.json").stat().st_mtime_ns == mtime
     got = json.loads((out / "summary.json").read_text())["drilling"]
     for k in ("heat_in", "thermal_energy_change", "chips_heat", "convection"):
         assert got["energy"][k] == pytest.approx(ref["energy"][k], rel=1e-12, abs=1e-12)

@@ -22,6 +22,9 @@ The same loop drills the axisymmetric (r, z) section (builder ``drilled-section`
 ``elasticity.plane = "axisymmetric"``): areas, volumes, the thermal energy, the chips' quadrature and the
 conservative transfer carry the weight 2 pi r; a thermocouple at (x, y, z) sits at r = hypot(x, y).
 
+After every completed step the process state is kept (:mod:`.drilling_state`): ``wendel run --resume`` goes on
+with the next step.
+
 Then the drill is withdrawn and the part cools on the last mesh (one launch, ``cooling_steps``
 increments). Time runs as the load factor: ``t = lf * T_total``; the traction table holds
 ``thrust / A / lf`` so that the traction FreeFEM scales by ``lf`` is the thrust of the step.
@@ -55,7 +58,7 @@ from ..remesh import step as remeshing
 from ..remesh.removal import conservative_transfer, removed_slice_quadrature
 from ..results import summary as report, vtu as output
 from ..results.drilling import bore_profile, plots, write_csv
-from . import launch
+from . import drilling_state as kept, launch
 from .checkpoint import RunFiles, State
 from .quasistatic import accept
 from .steps import StepCutError
@@ -88,13 +91,15 @@ def plan(block) -> tuple[list[Step], list[float]]:
     return steps, cooling
 
 
-def run(scene, scene_path: Path, out: Path, smoke: bool = False, progress=print) -> Path:
-    """Run the drilling scene ``scene`` into the folder ``out``; return it."""
+def run(scene, scene_path: Path, out: Path, smoke: bool = False, progress=print, resume: bool = False) -> Path:
+    """Run the drilling scene ``scene`` into the folder ``out``; return it. ``resume``: go on from the last
+    completed removal step kept in the folder (:mod:`.drilling_state`)."""
     files = RunFiles(Path(out).resolve())
-    if files.root.is_dir() and any(files.root.iterdir()):
-        raise ValueError(f"run folder {files.root} exists and is not empty: choose another --out")
-    files.root.mkdir(parents=True, exist_ok=True)
-    report.write_provenance(files.root, Path(scene_path), scene, smoke)
+    if not resume:
+        if files.root.is_dir() and any(files.root.iterdir()):
+            raise ValueError(f"run folder {files.root} exists and is not empty: choose another --out")
+        files.root.mkdir(parents=True, exist_ok=True)
+        report.write_provenance(files.root, Path(scene_path), scene, smoke)
     work = scene.model_copy(deep=True)
     if smoke and scene.smoke.steps is not None:
         work.drilling.steps = scene.smoke.steps             # smoke.steps: removal steps of a smoke run
@@ -115,13 +120,21 @@ def run(scene, scene_path: Path, out: Path, smoke: bool = False, progress=print)
              f"{len(cooling)} cooling increments, {total:.3g} s")
     state = State(pending=[])
     state.segments = []
-    launch.write_tables(work, files, dim)
     proc = Process(scene, work, files, state, entry, total, progress, dim)
     proc.plain = plain
+    done, cooled = 0, False
+    if resume:
+        done, cooled = kept.restore(proc)
+        progress(f"  resuming after removal step {done} of {len(steps)}{' and the cooling' if cooled else ''}")
+    else:
+        launch.write_tables(work, files, dim)
     for k, step in enumerate(steps, 1):
-        proc.removal_step(k, step)
-    if cooling:
+        if k > done:
+            proc.removal_step(k, step)
+            kept.save(proc, k, False)
+    if cooling and not cooled:
         proc.cool(cooling)
+        kept.save(proc, len(steps), True)
     summary = report.write_summary(files.root, work, state, dim)
     proc.finish(summary)
     return files.root
