@@ -9,7 +9,7 @@ APT_PACKAGES := freefem++ libfreefem++-dev openmpi-bin libopenblas0-pthread g++ 
                 libpetsc-real3.18-dev
 # Test only: a single-node SLURM with accounting for the sweep tests (scripts/slurm-local.sh).
 APT_TEST_PACKAGES := slurmctld slurmd slurm-client slurmdbd munge mariadb-server
-SCENE ?= workflows/smoke.toml
+SCENE ?= workflows/drilling-rz.toml   # the product's main job: a small drilling run in (r, z); elastic smoke: SCENE=workflows/smoke.toml
 
 .PHONY: setup run test bench clean
 setup: build/.apt-ok $(VENV)/.ok build/plugins/MUMPS_mpi.so build/plugins/wendel_petsc.so build/plugins/wendel_tool.so
