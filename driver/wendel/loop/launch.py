@@ -11,7 +11,7 @@ from __future__ import annotations
 from ..meshes import LABELS
 from ..scene import petsc
 from ..scene import axisymmetric
-from ..scene.blocks import BLOCKS, PROBLEMS
+from ..scene.blocks import BLOCKS, PROBLEMS, discretization
 from ..scene.schema import ANALYTIC_REFERENCES, BODY_FORCES, Scene
 from .checkpoint import RunFiles
 
@@ -45,7 +45,9 @@ def macros(scene: Scene, dimension: int) -> list[str]:
     """
     if scene.problem != "mechanics":
         return [f"-D{m}=1" for m in PROBLEMS[scene.problem].macros]
-    switches = [f"-Ddimension={dimension}", f"-DPk={axisymmetric.element(scene, dimension) or ELEMENT}"]
+    element = discretization.element(scene) or axisymmetric.element(scene, dimension) or ELEMENT
+    switches = [f"-Ddimension={dimension}", f"-DPk={element}"]
+    switches += discretization.macros(scene)       # -DWITHDG=1: edp/lib/dg.idp
     switches += [f"-D{BLOCKS[name].macro}=1" for name in scene.blocks if BLOCKS[name].macro]
     # a switch that depends on a key rather than on a block goes here: switches.append("-DNAME=1") when on
     switches += axisymmetric.macros(scene, dimension)
@@ -83,6 +85,8 @@ def options(scene: Scene, files: RunFiles, dimension: int, segment: dict | None 
     v = list(bf.value) + [0.0] * (3 - len(bf.value))
     opts += ["-body_id", str(BODY_FORCES[bf.kind]), "-body_fx", repr(v[0]), "-body_fy", repr(v[1]),
              "-body_fz", repr(v[2])]
+    if scene.reference.probe:
+        opts += [v for a, c in zip("xyz", scene.reference.probe) for v in (f"-probe_{a}", repr(float(c)))]
     if scene.reference.analytic:
         opts += ["-ref_id", str(ANALYTIC_REFERENCES[scene.reference.analytic])]
     for name in scene.blocks:

@@ -257,9 +257,18 @@ class Reference(Strict):
     errors: list[str] = Field(default_factory=list,
                               description="record.json keys of errors against closed forms, e.g. error_hertz_p0")
     quantity: str = Field("strain_energy", description="record.json quantity compared with the finest run")
+    probe: Optional[list[float]] = Field(None, min_length=2, max_length=3, description="point whose "
+                                         "displacement record.json gives as probe_ux, probe_uy(, probe_uz) [m]")
     compare: Optional[ComparisonName] = Field(
         None, description=f"another code's figures of the quantity, plotted by wendel study: {', '.join(COMPARISONS)}")
 
+
+    @field_validator("probe")
+    @classmethod
+    def _probe(cls, v):
+        if v is not None and not all(abs(c) < 1e30 for c in v):
+            raise ValueError(f"probe: coordinates must be finite numbers below 1e30 in size, got {v}")
+        return v
 
     @field_validator("errors")
     @classmethod
