@@ -24,10 +24,12 @@ def test_check_and_keys_import_nothing_heavy_and_take_little_cpu():
             "with contextlib.redirect_stdout(io.StringIO()):\n"
             "    assert cli.main(sys.argv[1:]) == 0\n"
             f"print([m for m in {HEAVY!r} if m in sys.modules])")
-    scenes = [str(p) for p in sorted(WORKFLOWS.glob("*.toml"))]
-    for args in (["check", *scenes], ["keys"]):
+    # a scene with an STL tool validates its triangles (closed, oriented) with numpy, and only that
+    stl = [str(p) for p in sorted(WORKFLOWS.glob("*.toml")) if "stl =" in p.read_text()]
+    scenes = [str(p) for p in sorted(WORKFLOWS.glob("*.toml")) if str(p) not in stl]
+    for args, allowed in ((["check", *scenes], "[]"), (["keys"], "[]"), (["check", *stl], "['numpy']")):
         out = subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True, check=True)
-        assert out.stdout.strip() == "[]", (args[0], out.stdout)
+        assert out.stdout.strip() == allowed, (args[0], out.stdout)
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     subprocess.run([sys.executable, "-m", "wendel.cli", "check", str(WORKFLOWS / "upsetting.toml")],
                    capture_output=True, check=True)
