@@ -88,7 +88,7 @@ def _when(run: Path, event: str) -> bool:
 
 
 KILL_POINTS = ["started", "committed-1", "committed-2", "meshing", "transfer", "reequilibrating", "committed-4",
-               "committed-5", "after-2.5"]
+               "committed-5", "after-1.5"]
 
 
 @pytest.mark.parametrize("event", KILL_POINTS)

@@ -59,6 +59,7 @@ class State:
     launches: list[dict] = field(default_factory=list)
     mesh_seconds: float = 0.0
     post_seconds: float = 0.0
+    behind_seconds: float = 0.0      # driver output done while FreeFEM solved (wendel.loop.overlap.Behind)
 
     @property
     def last(self) -> tuple[int, float]:
@@ -74,7 +75,8 @@ def save(files: RunFiles, scene: Scene, state: State, dimension: int) -> None:
             "accepted": state.accepted, "pending": state.pending, "cuts": state.cuts,
             "segments": state.segments, "remeshes": state.remeshes, "reequilibrate": state.reequilibrate,
             "quality": {str(k): v for k, v in state.quality.items()}, "step": state.step,
-            "launches": state.launches, "mesh_seconds": state.mesh_seconds, "post_seconds": state.post_seconds}
+            "launches": state.launches, "mesh_seconds": state.mesh_seconds, "post_seconds": state.post_seconds,
+            "behind_seconds": state.behind_seconds}
     tmp = files.checkpoint.with_suffix(".tmp")
     tmp.write_text(json.dumps(data, indent=1))
     os.replace(tmp, files.checkpoint)
@@ -91,7 +93,8 @@ def load_state(root: Path) -> tuple[RunFiles, Scene, State, int]:
     state = State(accepted=[tuple(a) for a in data["accepted"]], pending=data["pending"], cuts=data["cuts"],
                   launches=data["launches"], mesh_seconds=data["mesh_seconds"], post_seconds=data["post_seconds"],
                   segments=data["segments"], remeshes=data["remeshes"], reequilibrate=data["reequilibrate"],
-                  quality={int(k): v for k, v in data["quality"].items()}, step=data["step"])
+                  quality={int(k): v for k, v in data["quality"].items()}, step=data["step"],
+                  behind_seconds=data.get("behind_seconds", 0.0))
     return files, scene, state, data["dimension"]
 
 

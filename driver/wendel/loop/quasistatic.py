@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import contextlib
 import json
+import os
 import shutil
 import tempfile
 import time
@@ -24,6 +25,7 @@ from ..scene import load
 from ..scene.reading import check_size
 from ..scene.schema import Scene
 from .checkpoint import RunFiles, State, committed, save as _save_checkpoint
+from . import overlap
 from .guard import disk_full as _disk_full, guarded
 from .resume import restart, resume as resume_run
 from .launch import entry_script, macros, options, write_tables
@@ -183,6 +185,8 @@ def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress)
     launch runs a remeshing segment (FreeFEM ends it after a poor mesh, :mod:`wendel.remesh.batch`).
     """
     write_tables(scene, files, dimension)
+    if scene.remesh:            # imported while FreeFEM solves the first segment, not at the first remesh
+        overlap.preload("wendel.remesh.transfer", "wendel.remesh.mesher")
     entry = entry_script(scene, dimension)
     switches = macros(scene, dimension)
     while state.pending:
@@ -202,15 +206,22 @@ def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress)
             opts += ["-restart", str(files.fem / f"inc-{state.last[0]:04d}")]
         watcher = _Progress(files.fem, inc0, len(batch), batch, progress)
         failure, before, t0 = None, len(state.accepted), time.perf_counter()
+        # the increments FreeFEM commits are accepted while it solves the next ones (overlap.Behind)
+        behind = overlap.Behind(lambda: accept(scene, files, state, dimension), state,
+                                enabled=scene.numerics.ranks < (os.cpu_count() or 1))
         try:
-            with watcher:
+            with watcher, behind:
                 freefem.run(entry, switches + stop_args + opts, files.fem, ranks=scene.numerics.ranks,
                             timeout=scene.numerics.timeout, log=files.root / "freefem.log")
         except freefem.NewtonFailure as exc:
             failure = exc
         finally:
-            accept(scene, files, state, dimension)
-            state.launches.append({"wall": time.perf_counter() - t0, "increments": len(state.accepted) - before,
+            # the launch's wall time ends with FreeFEM (not after the driver's output, counted apart)
+            wall = (behind.ended or time.perf_counter()) - t0
+            state.post_seconds += behind.waited
+            if behind.error is None:
+                accept(scene, files, state, dimension)
+            state.launches.append({"wall": wall, "increments": len(state.accepted) - before,
                                    "complete": failure is None})
         stopped = bool(stop_args) and remesh_batch.settle(scene, files, state, dimension, inc0, progress)
         failure = None if stopped else failure
@@ -255,7 +266,7 @@ def accept(scene: Scene, files: RunFiles, state: State, dimension: int) -> None:
             break
         seg = state.segment(inc)
         if seg["mesh"] not in meshes:
-            points, cells = vtu.read_mesh(files.root / seg["mesh"], dimension)
+            points, cells = overlap.mesh_of(files.root / seg["mesh"], dimension)
             if seg["first"] == inc:
                 vtu.check_node_order(files.fem / "vertices.txt", points)
             meshes[seg["mesh"]] = (points, cells)

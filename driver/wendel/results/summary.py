@@ -3,7 +3,7 @@
 summary.json holds the fingerprints of the last increment (DoFs, Newton iterations, errors, physical
 quantities) and the wall time by phase: mesh (gmsh), FreeFEM start-up (launch wall time minus
 FreeFEM's own clock), assembly, linear solve, constitutive update, FreeFEM output, driver
-post-processing (VTU, PNG).
+post-processing (VTU, histories, checkpoints) on the critical path, remeshing and transfer, picture.
 """
 
 from __future__ import annotations
@@ -132,6 +132,9 @@ def write_summary(root: Path, scene, state, dimension: int, picture: float | Non
         phases["freefem_other"] += inner - rec["time_assembly"] - rec["time_solve"] - rec["time_constitutive"] - rec["time_output"]
     failed_wall = sum(l["wall"] for l, r in by_launch if r is None)
     phases["failed_launches"] = failed_wall
+    # remeshing and field transfer between launches (issue 20: they were in no phase)
+    phases["remesh"] = sum(r.get("remesh_seconds", 0.0) + r.get("transfer_seconds", 0.0)
+                           for r in getattr(state, "remeshes", []) if isinstance(r, dict))
     if picture is not None:
         phases["picture"] = picture
     total = sum(phases.values())
@@ -152,6 +155,8 @@ def write_summary(root: Path, scene, state, dimension: int, picture: float | Non
         "solver": last.get("solver"),
         "wall_time": total,
         "wall_time_by_phase": phases,
+        # VTU, histories and checkpoints of increments written while FreeFEM solved the next ones (in no phase)
+        "driver_output_behind": getattr(state, "behind_seconds", 0.0),
         "share_startup_and_io": (phases["freefem_startup"] + phases["freefem_output"] + phases["driver_output"]
                                  + phases.get("picture", 0.0)) / total
         if total else None,

@@ -15,7 +15,6 @@ from typing import Optional
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from .. import stl
 from . import choice
 
 ROOT = Path(__file__).resolve().parents[4]
@@ -70,6 +69,7 @@ class Tool(BaseModel):
         if self.stl is not None:
             if self.radii is not None:
                 raise ValueError("contact.tool.radii belong to a polygon (vertices), not to an STL surface")
+            from .. import stl       # numpy: only for scenes with an STL tool (`wendel check` stays light)
             try:
                 stl.table(stl.read(self.stl_path), str(self.stl_path))
             except ValueError as e:
@@ -140,6 +140,7 @@ def friction_options(block, files) -> list[str]:
             a = block.path.axis
             opts += ["-tool_axis_x", repr(float(a[0])), "-tool_axis_y", repr(float(a[1])), "-tool_axis_z", repr(float(a[2]))]
     if block.tool is not None and block.tool.stl is not None:
+        from .. import stl
         opts += ["-tool_stl", str(stl.write_table(block.tool.stl_path, files.tables / "tool_triangles.txt"))]
     elif block.tool is not None:
         v = block.tool.vertices
