@@ -9,14 +9,18 @@ of modules that exist and are tested on their own:
   in -x by ``cutting.cut_length`` over the load factor 0 -> 1, Coulomb friction ``cutting.friction`` on
   the whole ``free_surface`` (top of the layer and the step face; ``edp/lib/friction.idp``), capped at
   ``cutting.shear_cap`` when given;
-- Johnson-Cook plasticity with its rate term (time per unit load factor = cut length / speed), at the
-  room temperature: the prototype is **isothermal** (the ``[thermal]`` table is not solved: updated-
-  Lagrangian kinematics with heat is not written; the JC softening term is 1);
+- Johnson-Cook plasticity with its rate term (time per unit load factor = cut length / speed) and, when
+  ``thermal.coupling = "adiabatic"``, its thermal softening: the temperature is an internal variable of the
+  quadrature points heated by beta (Taylor-Quinney) of the plastic work (``edp/lib/thermal.idp``'s
+  adiabatic coupling, allowed with updated-Lagrangian kinematics when alpha = 0: the thermal expansion is
+  left out, and so is the frictional heat, which has no heat equation to enter). Other couplings: the cut
+  is isothermal (at T_room; conduction with UL is not written);
 - a remesh of the deformed body every ``cutting.remesh_every`` increments (and whenever the element
   quality falls below 0.1), uniform size ``geometry.fine * geometry.h``, with transfer of the UL state
   (``ul_eps``) and the plastic state (``wendel.remesh``).
 
-**Units.** The FE scene is written in mm, MPa and N (forces per unit width in N/mm): FreeFEM refuses
+**Units.** The FE scene is written in mm, MPa, N, s and K (forces per unit width in N/mm, energy mJ, so
+rho c in mJ/mm^3/K = 1e-6 J/m^3/K and k unchanged): FreeFEM refuses
 meshes with element areas below 1e-8 ("bug : mes < 1e-8 !", measured: a 25 um element is 6e-10 m^2).
 :func:`forces` converts back to N for the width b.
 
@@ -97,8 +101,10 @@ def fe_scene(scene, travel: float = 1.0) -> Scene:
         friction["tau_max"] = c.shear_cap * MPA
     steps = scene.loading.steps
     every = c.remesh_every
-    remesh = {"at": list(range(every, steps, every)) if every else [], "indicator": "", "h": fine * g.h * MM,
-              "max_remeshes": steps + 5}
+    # the re-equilibration after a remesh is an increment too: the k-th remesh follows increment k (every + 1) - 1
+    # (a step cut shifts the later ones by one increment)
+    at = [k * (every + 1) - 1 for k in range(1, (steps - 1) // every + 1)] if every else []
+    remesh = {"at": at, "indicator": "", "h": fine * g.h * MM, "max_remeshes": len(at) + 20}
     boundary = {}
     for name, b in scene.boundary.items():
         d = b.model_dump(exclude_none=True)
@@ -122,6 +128,12 @@ def fe_scene(scene, travel: float = 1.0) -> Scene:
         "output": {"png": False, "vtu": True},
         "remesh": remesh,
     }
+    th = scene.thermal
+    if th is not None and th.coupling == "adiabatic":      # heating by plastic work at the quadrature points
+        data["thermal"] = {"k": th.k, "rho": th.rho * 1e-6, "c": th.c, "alpha": 0.0, "T_ref": th.T_ref,
+                           "beta": th.beta, "coupling": "adiabatic", "duration": plasticity["load_time"]}
+        if th.T_initial is not None:
+            data["thermal"]["T_initial"] = th.T_initial
     return Scene.model_validate(data)
 
 

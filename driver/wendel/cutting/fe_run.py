@@ -10,9 +10,9 @@ and record and writes ``cutting.csv`` and ``cutting.json`` in the run folder, an
   any chip forms; the chip test's measure);
 - ``contact_length_m``: the largest distance from the tool tip, along the rake face, of a node in contact
   (``friction_state`` > 0) [m];
-- ``chip_thickness_m``: :func:`wendel.cutting.chip.chip_thickness` of the free boundary nodes between 1 and
-  2 h up the rake face from the tip (NaN while the chip is shorter than that);
-- ``tool_travel_m``, ``max_plastic_strain``, ``elements``.
+- ``chip_thickness_m``: :func:`wendel.cutting.chip.chip_thickness` of the free boundary nodes above 1.1 h
+  and between 1 and 2 h up the rake face from the tip (NaN while the chip is shorter than that);
+- ``tool_travel_m``, ``max_plastic_strain``, ``max_temperature_K`` (adiabatic cuts; NaN otherwise), ``elements``.
 
 ``cutting.json`` adds the Oxley prediction of the same scene (``wendel oxley``) and the last increment's
 values beside it.
@@ -31,7 +31,7 @@ from . import chip
 from .fe import MM, fe_scene, forces, tool_at_start
 
 COLUMNS = ["increment", "load_factor", "tool_travel_m", "Fc_N", "Ft_N", "chip_rise_m", "contact_length_m",
-           "chip_thickness_m", "max_plastic_strain", "elements"]
+           "chip_thickness_m", "max_plastic_strain", "max_temperature_K", "elements"]
 
 
 def run_cut(scene, scene_path: Path, out: Path, smoke: bool, progress=print, frames: bool = True) -> Path:
@@ -62,7 +62,7 @@ def measure(points: np.ndarray, cells: np.ndarray, state: np.ndarray, tip: np.nd
     active = state > 0.5
     length = float(((points[active] - tip) @ along).max()) if active.any() else 0.0
     free = _boundary_nodes(cells)
-    free = free[~active[free]]
+    free = free[~active[free] & (points[free, 1] > 1.1 * h)]      # the chip's back surface: risen above the layer
     try:
         thickness, _ = chip.chip_thickness(points[free], tip, rake, (h, 2 * h))
     except ValueError:
@@ -96,6 +96,7 @@ def report(root: Path, scene, frames: bool = True, travel: float = 1.0) -> list[
                      "Fc_N": fc, "Ft_N": ft, "chip_rise_m": got["chip_rise"] / MM,
                      "contact_length_m": got["contact_length"] / MM, "chip_thickness_m": got["chip_thickness"] / MM,
                      "max_plastic_strain": float(rec.get("max_plastic_strain") or 0.0),
+                     "max_temperature_K": float(rec.get("max_temperature") or "nan"),
                      "elements": int(float(rec["elements"]))})
         if frames:
             from .fe_frames import frame
@@ -106,7 +107,7 @@ def report(root: Path, scene, frames: bool = True, travel: float = 1.0) -> list[
         w = csv.DictWriter(f, fieldnames=COLUMNS)
         w.writeheader()
         w.writerows(rows)
-    summary = {"last": rows[-1] if rows else None, "width_m": c.width, "isothermal": True}
+    summary = {"last": rows[-1] if rows else None, "width_m": c.width, "adiabatic": fe.thermal is not None}
     try:
         from .scene import predict, row
         summary["oxley"] = row(predict(scene))
