@@ -1,9 +1,10 @@
 """Orthogonal cutting, finite-element part (issue 17 prototype): a chip forms at the rounded edge.
 
-The steel scene, cut 60 um (0.4 h) in 12 increments on its 25 um mesh, remeshed every 2 increments: the
-material in front of the rake face must rise above the top of the uncut layer (a chip starting up the
-rake face), the forces on the tool must be positive and finite with F_c > F_t, and the remeshes must carry
-the updated-Lagrangian state (the re-equilibration converges from the transferred state)."""
+The steel scene (adiabatic Johnson-Cook), cut 60 um (0.4 h) in 12 increments on its 25 um mesh, remeshed
+every 2 increments: the material in front of the rake face must rise above the top of the uncut layer (a
+chip starting up the rake face), the forces on the tool must be positive and finite with F_c > F_t, the
+plastic work must heat the primary zone, and the remeshes must carry the updated-Lagrangian state (the
+re-equilibration converges from the transferred state)."""
 
 import csv
 import json
@@ -46,6 +47,7 @@ def test_fe_cut_forms_a_chip(tmp_path):
     scene = load(STEEL, smoke=True)
     scene.cutting.cut_length = 0.06e-3        # m: 12 increments of 5 um, as in the full scene
     scene.loading.steps = 12
+    scene.cutting.remesh_every = 2
     root = run_cut(scene, STEEL, tmp_path / "cut", smoke=False, progress=lambda *_: None, frames=True)
     rows = list(csv.DictReader((root / "cutting.csv").open()))
     assert len(rows) >= 12
@@ -60,6 +62,7 @@ def test_fe_cut_forms_a_chip(tmp_path):
     assert last["chip_rise_m"] > 0.05 * h
     assert last["contact_length_m"] > 0.5 * h
     assert last["max_plastic_strain"] > 0.3
+    assert last["max_temperature_K"] > scene.thermal.T_ref + 50           # adiabatic heating
     s = json.loads((root / "summary.json").read_text())
     assert len(s["remeshes"]) >= 5
     for k in range(1, 4):

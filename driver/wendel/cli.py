@@ -76,7 +76,8 @@ def main(argv: list[str] | None = None) -> int:
                    "  axisymmetric, cylinder, drilling, elasticity, friction, obstacle, petsc, remesh, step42,\n"
                    "  sweep, thermal, ul,\n"
                    "  oxley, oxley-domain, oxley-kienzle (the analytic orthogonal cut);\n"
-                   "only when named: step42-dealii, overhead, gmsh3d")
+                   "only when named: step42-dealii, overhead, gmsh3d,\n"
+                   "  cutting, cutting-isothermal (the FE orthogonal cut, about 4 minutes each)")
     p.add_argument("--quick", action="store_true", help="small sizes only")
 
     p = sub.add_parser("sweep", help="campaigns: a plan of runs, locally or on SLURM (see wendel.sweep)")

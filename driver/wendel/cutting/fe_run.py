@@ -39,7 +39,13 @@ def run_cut(scene, scene_path: Path, out: Path, smoke: bool, progress=print, fra
     from ..loop.quasistatic import run_scene
     from ..scene import load
     travel = scene.loading.steps / load(scene_path).loading.steps if smoke else 1.0
-    root = run_scene(fe_scene(scene, travel), scene_path, out, smoke, progress)
+    try:
+        root = Path(run_scene(fe_scene(scene, travel), scene_path, out, smoke, progress))
+    except Exception:
+        root = Path(out).resolve()
+        if (root / "history.csv").is_file():       # a cut that stops: its accepted increments are reported
+            report(root, scene, frames=frames, travel=travel)
+        raise
     rows = report(root, scene, frames=frames, travel=travel)
     if rows:
         r = rows[-1]
