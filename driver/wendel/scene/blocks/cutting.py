@@ -71,7 +71,7 @@ class Cutting(BaseModel):
     c_slope: float = Field(0.0, description="dc/dT of the work material [J/kg/K^2]")
     cut_length: Optional[float] = Field(None, gt=0, description="FE: length of cut, the tool's travel over the "
                                         "load factor 0 -> 1 [m]; default 2 uncut_thickness")
-    remesh_every: int = Field(2, ge=0, le=1000, description="FE: remesh the deformed workpiece after every this "
+    remesh_every: int = Field(4, ge=0, le=1000, description="FE: remesh the deformed workpiece after every this "
                               "many increments (0: only when the element quality falls below 0.1) [1]")
     oxley: OxleyConstants = OxleyConstants()
 
