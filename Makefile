@@ -9,22 +9,15 @@ APT_PACKAGES := freefem++ libfreefem++-dev openmpi-bin libopenblas0-pthread g++ 
                 libpetsc-real3.18-dev
 # Test only: a single-node SLURM with accounting for the sweep tests (scripts/slurm-local.sh).
 APT_TEST_PACKAGES := slurmctld slurmd slurm-client slurmdbd munge mariadb-server
-SCENE ?= workflows/smoke.toml
+SCENE ?= workflows/drilling-rz.toml   # the product's main job: a small drilling run in (r, z); elastic smoke: SCENE=workflows/smoke.toml
 
 .PHONY: setup run test bench clean
-setup: build/.apt-ok $(VENV)/.ok build/plugins/MUMPS_mpi.so build/plugins/wendel_petsc.so
+setup: build/.apt-ok $(VENV)/.ok build/plugins/MUMPS_mpi.so build/plugins/wendel_petsc.so build/plugins/wendel_tool.so
 
 # Debian packages: FreeFEM, Open MPI, OpenBLAS under FreeFEM's direct solvers, Mesa for off-screen pictures.
-build/.apt-ok: Makefile
+build/.apt-ok: Makefile scripts/apt-ensure.sh
 	@mkdir -p build
-	@n_ok=$$(dpkg-query -W -f='$${Status}\n' $(APT_PACKAGES) 2>/dev/null | grep -c '^install ok installed$$'); \
-	if [ "$$n_ok" -eq "$(words $(APT_PACKAGES))" ]; then \
-	  echo "apt: all packages present"; \
-	else \
-	  echo "apt: installing $(APT_PACKAGES)"; \
-	  SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
-	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq --no-install-recommends $(APT_PACKAGES); \
-	fi
+	scripts/apt-ensure.sh packages $(APT_PACKAGES)
 	@touch $@
 
 # Python: a venv with the package in editable mode, versions pinned by constraints.txt.
@@ -47,21 +40,18 @@ build/plugins/wendel_petsc.so: edp/plugins/wendel_petsc.cpp build/.apt-ok
 	  -I/usr/lib/x86_64-linux-gnu/openmpi/include -DOMPI_SKIP_MPICXX $< -o $@ \
 	  -L$(PETSC_DIR)/lib -Wl,-rpath,$(PETSC_DIR)/lib -lpetsc_real -lmpi
 
+# wendel's tool plugin (lib/tool.idp): signed distance to a closed triangulated surface (an STL tool).
+build/plugins/wendel_tool.so: edp/plugins/wendel_tool.cpp build/.apt-ok
+	@mkdir -p build/plugins
+	g++ -shared -fPIC -O2 -Wall -Wno-unused-variable -Wno-sign-compare -Wno-mismatched-new-delete -isystem /usr/include/freefem++ $< -o $@
+
 run: setup
 	$(VENV)/bin/wendel run $(SCENE)
 
 # SLURM, munge and MariaDB for tests/test_sweep.py (their daemons are started by the test, not by apt).
-build/.apt-test-ok: Makefile
+build/.apt-test-ok: Makefile scripts/apt-ensure.sh
 	@mkdir -p build
-	@n_ok=$$(dpkg-query -W -f='$${Status}\n' $(APT_TEST_PACKAGES) 2>/dev/null | grep -c '^install ok installed$$'); \
-	if [ "$$n_ok" -eq "$(words $(APT_TEST_PACKAGES))" ]; then \
-	  echo "apt: test packages present"; \
-	else \
-	  echo "apt: installing $(APT_TEST_PACKAGES)"; \
-	  SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
-	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq --no-install-recommends $(APT_TEST_PACKAGES) \
-	    || echo "apt: test packages not installed: the SLURM tests will be skipped"; \
-	fi
+	scripts/apt-ensure.sh "test packages" --optional $(APT_TEST_PACKAGES)
 	@touch $@
 
 test: setup build/.apt-test-ok

@@ -9,6 +9,8 @@ from .builders import BUILDERS, build, Built
 from . import axisymmetric  # noqa: F401  (registers the (r, z) section builders)
 from . import cutting  # noqa: F401  (registers the orthogonal-cutting builder)
 from . import drilling  # noqa: F401  (registers the drilled-* builders)
+from . import cook  # noqa: F401  (registers Cook's membrane)
+from . import notched  # noqa: F401  (registers the notched plate)
 from .labels import LABELS, NAMES
 
 __all__ = ["BUILDERS", "build", "Built", "LABELS", "NAMES"]

@@ -102,16 +102,30 @@ def sphere_section(path: Path, r_inner=0.0, r_outer=1.0, h=0.05, refine=None, ha
 
 
 @register("notched_bar", ["axis", "outer", "top", "symmetry_y"])
-def notched_bar(path: Path, radius=0.5, length=2.0, notch_radius=0.1, h=0.05, refine=None) -> Built:
+def notched_bar(path: Path, radius=0.5, length=2.0, notch_radius=0.1, h=0.05, refine=None, imperfection=0.0) -> Built:
     """Half of a round bar in (r, z): [0, radius] x [0, length / 2] (m), mirrored at z = 0 (boundary
     symmetry_y), with a circular notch of ``notch_radius`` (m) centred on the outer surface at z = 0 (the
-    imperfection where the bar necks; 0 = a plain bar). Boundaries: axis, outer (surface and notch), top,
-    symmetry_y."""
+    imperfection where the bar necks; 0 = a plain bar), or (``notch_radius = 0``) a smooth radius
+    imperfection: r(z) = radius (1 - imperfection (1 + cos(2 pi z / length)) / 2), ``imperfection`` (1) the
+    relative reduction of the radius at z = 0 (the necking bar of Simo 1988: 0.018). Boundaries: axis, outer
+    (surface and notch), top, symmetry_y."""
     if not 0 <= notch_radius < radius:
         raise ValueError(f"notched_bar needs 0 <= notch_radius < radius, got {notch_radius}, {radius}")
+    if not 0 <= imperfection < 0.5 or (imperfection > 0 and notch_radius > 0):
+        raise ValueError(f"notched_bar: imperfection must be in [0, 0.5) and needs notch_radius = 0, got {imperfection}")
     with _Session("notched_bar") as gmsh:
         occ = gmsh.model.occ
-        shape = [(2, occ.addRectangle(0, 0, 0, radius, length / 2))]
+        if imperfection > 0:
+            n = 40
+            zs = [length / 2 * i / n for i in range(n + 1)]
+            rim = [occ.addPoint(radius * (1 - imperfection * (1 + math.cos(2 * math.pi * z / length)) / 2), z, 0)
+                   for z in zs]
+            p0, p1 = occ.addPoint(0, 0, 0), occ.addPoint(0, length / 2, 0)
+            loop = occ.addCurveLoop([occ.addLine(p0, rim[0]), occ.addSpline(rim), occ.addLine(rim[-1], p1),
+                                     occ.addLine(p1, p0)])
+            shape = [(2, occ.addPlaneSurface([loop]))]
+        else:
+            shape = [(2, occ.addRectangle(0, 0, 0, radius, length / 2))]
         if notch_radius > 0:
             shape, _ = occ.cut(shape, [(2, occ.addDisk(radius, 0, 0, notch_radius, notch_radius))])
         occ.synchronize()

@@ -20,7 +20,7 @@ of the tip). Its volume (:func:`bore_volume`) is
 After a boolean the order and numbering of entities is not documented, so every boundary entity is
 classified by its geometry (centre, points on it, bounding box): bore wall (r = R), bore bottom (the tip
 cone), entry face (top, z = H), base (bottom, z = 0), outer faces (outer for a cylinder, left/right/
-front/back for a block; in 2D outer at r = R_w and symmetry_x on the axis r = 0 below the bore).
+front/back for a block; in 2D outer at r = R_w and axis on r = 0 below the bore).
 The mesh is graded towards the bore wall and bottom: size ``h_bore`` there, growing to ``h`` over the
 distance ``grade``.
 
@@ -190,7 +190,7 @@ def drilled_section(path: Path, depth: float = 0.0, diameter: float = 0.01, poin
     bore profile of a drill with its tip ``depth`` below the face z = H.
 
     Boundaries: bore_wall (r = R), bore_bottom (the cone's generatrix), top, bottom, outer (r = radius) and
-    symmetry_x (the axis r = 0 below the tip).
+    axis (r = 0 below the tip; the axisymmetric model pins u_r = 0 there by itself).
     """
     _check(depth, diameter, point_angle, height)
     R, H = diameter / 2, height
@@ -211,15 +211,15 @@ def drilled_section(path: Path, depth: float = 0.0, diameter: float = 0.01, poin
             occ.cut([(2, body)], [(2, drill)])
         occ.synchronize()
         tol = 1e-6 * max(H, radius)
-        groups: dict[str, list[int]] = {n: [] for n in (*BORE, "top", "bottom", "outer", "symmetry_x")}
+        groups: dict[str, list[int]] = {n: [] for n in (*BORE, "top", "bottom", "outer", "axis")}
         for _, c in gmsh.model.getEntities(1):
             pts = _samples(gmsh, 1, c)
             on = lambda k, v: all(abs(p[k] - v) < tol for p in pts)
             name = ("top" if on(1, H) else "bottom" if on(1, 0.0) else "outer" if on(0, radius) else
-                    "symmetry_x" if on(0, 0.0) else "bore_wall" if on(0, R) else "bore_bottom")
+                    "axis" if on(0, 0.0) else "bore_wall" if on(0, R) else "bore_bottom")
             groups[name].append(c)
         _grading(gmsh, h, h_bore, grade, groups["bore_wall"] + groups["bore_bottom"], 2)
-        names = [n for n in (*BORE, "top", "bottom", "outer", "symmetry_x") if groups[n]]
+        names = [n for n in (*BORE, "top", "bottom", "outer", "axis") if groups[n]]
         for n in names:
             gmsh.model.addPhysicalGroup(1, groups[n], LABELS[n], n)
         gmsh.model.addPhysicalGroup(2, [t for _, t in gmsh.model.getEntities(2)], LABELS["domain"], "domain")
@@ -242,7 +242,7 @@ def drilled_block(path: Path, depth=0.0, diameter=0.01, point_angle=118.0, x=(-0
                    h_bore=h_bore, grade=grade)
 
 
-@register("drilled-section", boundaries=["bore_wall", "bore_bottom", "top", "bottom", "outer", "symmetry_x"])
+@register("drilled-section", boundaries=["bore_wall", "bore_bottom", "top", "bottom", "outer", "axis"])
 def drilled_section_builder(path: Path, depth=0.0, diameter=0.01, point_angle=118.0, radius=0.02, height=0.03,
                             h=0.004, h_bore=None, grade=None) -> Built:
     """The axisymmetric (r, z) section of a drilled cylinder (for axisymmetric scenes)."""

@@ -64,7 +64,7 @@ def test_removed_volume_axisymmetric_section(tmp_path, depth):
     vol = (2 * math.pi * p[tri].mean(axis=1)[:, 0] * cell_volumes(p, tri)).sum()
     assert math.pi * 0.012 ** 2 * 0.02 - vol == pytest.approx(D.bore_volume(depth, R, ANGLE), rel=1e-9, abs=1e-15)
     labels = _facet_labels(m, "line")
-    assert {LABELS[n] for n in ("top", "bottom", "outer", "symmetry_x")} <= labels
+    assert {LABELS[n] for n in ("top", "bottom", "outer", "axis")} <= labels
     assert (LABELS["bore_bottom"] in labels) == (depth > 0)
 
 

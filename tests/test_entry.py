@@ -25,9 +25,9 @@ GUARDS = {"plasticity": "wendelPlasticityIdp", "contact": "wendelContactIdp", "t
           "thermal-fields": "wendelThermalFieldsIdp", "elasticity": "wendelElasticityIdp",
           "axisymmetric": "wendelAxisymmetricIdp", "axisymmetric-mechanics": "wendelAxisymmetricMechanicsIdp",
           "remeshstop": "wendelRemeshStopIdp", "kinematics": "wendelKinematicsIdp",
-          "friction": "wendelFrictionIdp", "tool": "wendelToolIdp", "petsc": "wendelPetscIdp"}
+          "friction": "wendelFrictionIdp", "tool": "wendelToolIdp", "petsc": "wendelPetscIdp", "dg": "wendelDgIdp"}
 MODULES = ("plasticity", "contact", "thermal", "thermal-fields", "axisymmetric", "axisymmetric-mechanics", "remeshstop",
-           "kinematics", "friction", "tool")
+           "kinematics", "friction", "tool", "dg")
 
 
 def compiled(tmp_path, scene_name: str, solver: str | None = None) -> tuple[set[str], list[str], dict]:

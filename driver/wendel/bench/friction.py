@@ -2,8 +2,10 @@
 solve of the same scene (``wendel bench friction``; ``--quick``: smoke sizes).
 
 Scenes: the Hertz cylinder (workflows/hertz.toml: frictionless by contact.idp's axis gap, frictionless and
-Coulomb mu = 0.3 by friction.idp in the current configuration) and the sliding block
-(workflows/sliding-block.toml: frictionless, Coulomb mu = 0.3, Tresca 3e4 Pa).
+Coulomb mu = 0.3 by friction.idp in the current configuration), the sliding block
+(workflows/sliding-block.toml: frictionless, Coulomb mu = 0.3, Tresca 3e4 Pa), the 3D sliding block
+(frictionless, Coulomb mu = 0.3) and the STL sphere (workflows/stl-ball.toml) against the analytic ball
+(the cost of the closest point on the triangles).
 """
 
 from __future__ import annotations
@@ -24,6 +26,10 @@ CASES = [
     ("sliding-block", "frictionless (friction.idp)", {"law": "none"}),
     ("sliding-block", "Coulomb mu = 0.3 (friction.idp)", {"law": "coulomb", "mu": 0.3}),
     ("sliding-block", "Tresca 3e4 Pa (friction.idp)", {"law": "tresca", "tau_max": 3.0e4}),
+    ("sliding-block-3d", "frictionless (friction.idp)", {"law": "none"}),
+    ("sliding-block-3d", "Coulomb mu = 0.3 (friction.idp)", {"law": "coulomb", "mu": 0.3}),
+    ("stl-ball", "analytic ball, frictionless (friction.idp)", "ball"),
+    ("stl-ball", "STL sphere, frictionless (friction.idp)", None),
 ]
 
 
@@ -39,7 +45,10 @@ def bench_friction(quick: bool, workdir: Path) -> list[dict]:
         path = ROOT / "workflows" / f"{name}.toml"
         scene = load(path, smoke=quick)
         scene.output.png = False
-        if friction is not None:
+        if friction == "ball":          # the analytic sphere the STL file approximates, through the same module
+            scene.contact = scene.contact.model_copy(update={"obstacle": "ball", "tool": None,
+                                                              "friction": Friction(law="none")})
+        elif friction is not None:
             scene.contact.friction = Friction(**friction)
         out = workdir / f"{k}-{name}"
         shutil.rmtree(out, ignore_errors=True)
@@ -48,7 +57,8 @@ def bench_friction(quick: bool, workdir: Path) -> list[dict]:
         last = s["last_increment"]
         row = {"scene": name, "variant": variant, "dofs": s["dofs"], "increments": s["increments"],
                "newton_iterations": s["newton_iterations"], "wall_time": round(s["wall_time"], 3),
-               "contact_force": last.get("contact_force"), "friction_ratio": last.get("friction_ratio")}
+               "contact_force": last.get("contact_force"), "friction_ratio": last.get("friction_ratio"),
+               "error_contact_size": last.get("error_contact_size")}
         base.setdefault(name, row)
         row["iterations_vs_frictionless"] = round(row["newton_iterations"] / base[name]["newton_iterations"], 3)
         row["time_vs_frictionless"] = round(row["wall_time"] / base[name]["wall_time"], 3)

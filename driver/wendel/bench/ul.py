@@ -15,10 +15,13 @@ from . import WORKFLOWS, register
 @register("ul")
 def ul_bench(quick: bool, workdir: Path) -> list[dict]:
     """Plane-strain compression (2D) and uniaxial tension of a cube (3D) with linear hardening to 5 % in 5
-    increments (small enough for small strain to be a fair comparison), small strain against
-    updated-Lagrangian, at growing mesh sizes."""
+    increments (small enough for small strain to be a fair comparison), and the necking bar (axisymmetric,
+    Voce) to 1 mm in 10, small strain against updated-Lagrangian, at growing mesh sizes."""
     cases = [("2d", "ul-compression.toml", h) for h in ([0.04] if quick else [0.04, 0.02, 0.01])]
     cases += [("3d", "ul-tension-3d.toml", h) for h in ([0.25] if quick else [0.25, 0.125])]
+    # the necking bar (axisymmetric, Voce hardening) to 1 mm of elongation in 10 increments: a path on which
+    # small strain is nonlinear too (the plastic zone spreads from the imperfection)
+    cases += [("axi", "ul-necking-bar.toml", h) for h in ([1e-3] if quick else [1e-3, 0.5e-3])]
     rows = []
     for dim, name, h in cases:
         path = WORKFLOWS / name
@@ -30,8 +33,12 @@ def ul_bench(quick: bool, workdir: Path) -> list[dict]:
             scene.loading.steps = 5
             if dim == "2d":
                 scene.boundary["top"].uy = -0.05
-            else:
+            elif dim == "3d":
                 scene.boundary["top"].uz = 0.05
+            else:
+                scene.loading.steps = 10
+                scene.boundary["top"].uy = 0.5e-3
+                scene.geometry.params["refine"]["h"] = 0.4 * h
             scene.output.png = False
             scene.output.vtu = False
             out = workdir / f"{dim}-h{h:g}-{kind}"

@@ -18,6 +18,13 @@ start_depth) / steps``, then dwells at the bottom):
    the bore bottom, optional convection on the bore;
 5. **write**: VTU (the series runs across every remesh), probe temperatures, bore profile, energies.
 
+The same loop drills the axisymmetric (r, z) section (builder ``drilled-section`` with
+``elasticity.plane = "axisymmetric"``): areas, volumes, the thermal energy, the chips' quadrature and the
+conservative transfer carry the weight 2 pi r; a thermocouple at (x, y, z) sits at r = hypot(x, y).
+
+After every completed step the process state is kept (:mod:`.drilling_state`): ``wendel run --resume`` goes on
+with the next step.
+
 Then the drill is withdrawn and the part cools on the last mesh (one launch, ``cooling_steps``
 increments). Time runs as the load factor: ``t = lf * T_total``; the traction table holds
 ``thrust / A / lf`` so that the traction FreeFEM scales by ``lf`` is the thrust of the step.
@@ -51,7 +58,7 @@ from ..remesh import step as remeshing
 from ..remesh.removal import conservative_transfer, removed_slice_quadrature
 from ..results import summary as report, vtu as output
 from ..results.drilling import bore_profile, plots, write_csv
-from . import launch
+from . import drilling_state as kept, launch
 from .checkpoint import RunFiles, State
 from .quasistatic import accept
 from .steps import StepCutError
@@ -84,13 +91,15 @@ def plan(block) -> tuple[list[Step], list[float]]:
     return steps, cooling
 
 
-def run(scene, scene_path: Path, out: Path, smoke: bool = False, progress=print) -> Path:
-    """Run the drilling scene ``scene`` into the folder ``out``; return it."""
+def run(scene, scene_path: Path, out: Path, smoke: bool = False, progress=print, resume: bool = False) -> Path:
+    """Run the drilling scene ``scene`` into the folder ``out``; return it. ``resume``: go on from the last
+    completed removal step kept in the folder (:mod:`.drilling_state`)."""
     files = RunFiles(Path(out).resolve())
-    if files.root.is_dir() and any(files.root.iterdir()):
-        raise ValueError(f"run folder {files.root} exists and is not empty: choose another --out")
-    files.root.mkdir(parents=True, exist_ok=True)
-    report.write_provenance(files.root, Path(scene_path), scene, smoke)
+    if not resume:
+        if files.root.is_dir() and any(files.root.iterdir()):
+            raise ValueError(f"run folder {files.root} exists and is not empty: choose another --out")
+        files.root.mkdir(parents=True, exist_ok=True)
+        report.write_provenance(files.root, Path(scene_path), scene, smoke)
     work = scene.model_copy(deep=True)
     if smoke and scene.smoke.steps is not None:
         work.drilling.steps = scene.smoke.steps             # smoke.steps: removal steps of a smoke run
@@ -101,7 +110,8 @@ def run(scene, scene_path: Path, out: Path, smoke: bool = False, progress=print)
     if getattr(work, "plasticity", None) is not None:
         work.plasticity.load_time = total
     plain = work.model_copy(update={"drilling": None})      # the mechanics + thermal entry script
-    entry = launch.entry_script(plain, 3)
+    dim = 2 if scene.geometry.builder == "drilled-section" else 3      # (r, z) section or 3D body
+    entry = launch.entry_script(plain, dim)
     steps, cooling = plan(block)
     progress(f"wendel: {scene.description}")
     progress(f"  run folder {files.root}")
@@ -110,14 +120,22 @@ def run(scene, scene_path: Path, out: Path, smoke: bool = False, progress=print)
              f"{len(cooling)} cooling increments, {total:.3g} s")
     state = State(pending=[])
     state.segments = []
-    launch.write_tables(work, files, 3)
-    proc = Process(scene, work, files, state, entry, total, progress)
+    proc = Process(scene, work, files, state, entry, total, progress, dim)
     proc.plain = plain
+    done, cooled = 0, False
+    if resume:
+        done, cooled = kept.restore(proc)
+        progress(f"  resuming after removal step {done} of {len(steps)}{' and the cooling' if cooled else ''}")
+    else:
+        launch.write_tables(work, files, dim)
     for k, step in enumerate(steps, 1):
-        proc.removal_step(k, step)
-    if cooling:
+        if k > done:
+            proc.removal_step(k, step)
+            kept.save(proc, k, False)
+    if cooling and not cooled:
         proc.cool(cooling)
-    summary = report.write_summary(files.root, work, state, 3)
+        kept.save(proc, len(steps), True)
+    summary = report.write_summary(files.root, work, state, dim)
     proc.finish(summary)
     return files.root
 
@@ -125,8 +143,9 @@ def run(scene, scene_path: Path, out: Path, smoke: bool = False, progress=print)
 class Process:
     """The state of a drilling run between steps, and its records."""
 
-    def __init__(self, scene, work, files, state, entry, total, progress):
+    def __init__(self, scene, work, files, state, entry, total, progress, dim: int = 3):
         self.scene, self.work, self.files, self.state = scene, work, files, state
+        self.dim, self.axi = dim, dim == 2          # 2: the axisymmetric (r, z) section (x = r, y = z)
         self.block, self.entry, self.total, self.progress = scene.drilling, entry, total, progress
         th = work.thermal
         self.rho_c = th.rho * th.c
@@ -147,15 +166,23 @@ class Process:
         params = {k: v for k, v in self.g.params.items() if k != "h"}
         workpiece = "cylinder" if self.g.builder == "drilled-cylinder" else "block"
         with remeshing._quiet_stdout():
-            geometry.drilled(path, workpiece, depth=depth, diameter=self.block.diameter,
-                             point_angle=self.block.point_angle, h=self.g.h, h_bore=self.h_bore,
-                             grade=self.block.grade, **params)
+            if self.axi:
+                geometry.drilled_section(path, depth=depth, diameter=self.block.diameter,
+                                         point_angle=self.block.point_angle, h=self.g.h, h_bore=self.h_bore,
+                                         grade=self.block.grade, **params)
+            else:
+                geometry.drilled(path, workpiece, depth=depth, diameter=self.block.diameter,
+                                 point_angle=self.block.point_angle, h=self.g.h, h_bore=self.h_bore,
+                                 grade=self.block.grade, **params)
         pts, _, cells, _, facets, tags = mesher.read_mesh(path)
         return {"points": pts, "cells": cells, "facets": facets, "tags": tags}
 
     def areas(self, mesh: dict) -> dict[str, float]:
         p, f, tags = mesh["points"], mesh["facets"], mesh["tags"]
-        a = 0.5 * np.linalg.norm(np.cross(p[f[:, 1]] - p[f[:, 0]], p[f[:, 2]] - p[f[:, 0]]), axis=1)
+        if self.axi:        # (r, z) edges: the areas of their surfaces of revolution, 2 pi r_mid |e| (exact)
+            a = 2 * np.pi * 0.5 * (p[f[:, 0], 0] + p[f[:, 1], 0]) * np.linalg.norm(p[f[:, 1]] - p[f[:, 0]], axis=1)
+        else:
+            a = 0.5 * np.linalg.norm(np.cross(p[f[:, 1]] - p[f[:, 0]], p[f[:, 2]] - p[f[:, 0]]), axis=1)
         return {n: float(a[tags == LABELS[n]].sum()) for n in geometry.BORE}
 
     # ---- one removal step
@@ -191,14 +218,16 @@ class Process:
             def make_mesh(xd, mesh_old, mesh_new, h, size_indicator=None, h_min=None):
                 built["mesh"] = self.build(step.depth, Path(mesh_new))
                 q = quality.mesh_quality(built["mesh"]["points"], built["mesh"]["cells"])
-                return {"min_sicn": q["min"], "measure_old": float(remeshing.cell_volumes(xd, old_mesh["cells"]).sum()),
-                        "measure_new": float(remeshing.cell_volumes(built["mesh"]["points"], built["mesh"]["cells"]).sum())}
+                pts = built["mesh"]["points"][:, :self.dim]
+                return {"min_sicn": q["min"],
+                        "measure_old": float(remeshing.cell_volumes(xd, old_mesh["cells"], self.axi).sum()),
+                        "measure_new": float(remeshing.cell_volumes(pts, built["mesh"]["cells"], self.axi).sum())}
 
             state_rel = f"remesh/state-{k:03d}"
             ubase_old = output.read_array(files.root / old_seg["ubase"]) if old_seg["ubase"] else None
-            rep = remeshing.remesh_state(old_inc, files.root / old_seg["mesh"], ubase_old, 3, files.root / mesh_rel,
-                                         files.root / state_rel, self.g.h, self.h_bore, "", make_mesh=make_mesh,
-                                         deformed=False)
+            rep = remeshing.remesh_state(old_inc, files.root / old_seg["mesh"], ubase_old, self.dim,
+                                         files.root / mesh_rel, files.root / state_rel, self.g.h, self.h_bore, "",
+                                         axisymmetric=self.axi, make_mesh=make_mesh, deformed=False)
             mesh = built["mesh"]
             if self.block.transfer == "conservative":
                 self.conserve_heat(old_mesh, old_inc, mesh, files.root / state_rel, rep)
@@ -240,7 +269,8 @@ class Process:
         t0 = time.perf_counter()
         T_old = output.read_array(old_inc / "therm_T.node.txt")
         rep["energy_interpolated"] = self.energy(mesh, output.read_array(state_dir / "therm_T.node.txt"))
-        T_new, _ = conservative_transfer(old_mesh["points"], old_mesh["cells"], T_old, mesh["points"], mesh["cells"])
+        T_new, _ = conservative_transfer(old_mesh["points"], old_mesh["cells"], T_old, mesh["points"], mesh["cells"],
+                                         axisymmetric=self.axi)
         output.write_array(state_dir / "therm_T.node.txt", T_new)
         if output.read_array(state_dir / "therm_T.qp.txt").size == len(mesh["cells"]):     # P1: one point per cell
             output.write_array(state_dir / "therm_T.qp.txt", transfer.nodes_to_cells(mesh["cells"], T_new))
@@ -262,7 +292,7 @@ class Process:
     def launch(self, inc0: int, times: list[float], seg: dict, fluxes: dict, traction: float, restart) -> None:
         files, work, state = self.files, self.work, self.state
         lfs = [t / self.total for t in times]
-        opts = launch.options(work, files, 3, seg)       # writes the scene's thermal table: replaced below
+        opts = launch.options(work, files, self.dim, seg)       # writes the scene's thermal table: replaced below
         rows = [(LABELS[n], *b.row()) for n, b in work.thermal.boundary.items()]
         for n, q in fluxes.items():
             if q:
@@ -273,12 +303,14 @@ class Process:
             f"{len(rows)}\n" + "".join(f"{lab} {kind} {a!r} {b!r}\n" for lab, kind, a, b in rows))
         trac = [line for line in (files.tables / "trac.txt").read_text().splitlines()[1:] if line.strip()]
         trac = [r for r in trac if int(r.split()[0]) != LABELS["bore_bottom"]]
-        if traction and len(lfs) == 1:
-            trac.append(f"{LABELS['bore_bottom']} 0.0 0.0 {traction / lfs[0]!r} 0.0")
+        if traction and len(lfs) == 1:      # axial: z in 3D, y = z in (r, z)
+            t = [0.0, 0.0, 0.0]
+            t[self.dim - 1] = traction / lfs[0]
+            trac.append(f"{LABELS['bore_bottom']} {t[0]!r} {t[1]!r} {t[2]!r} 0.0")
         (files.tables / "trac.txt").write_text(f"{len(trac)}\n" + "".join(r + "\n" for r in trac))
         loads = files.tables / "loads.txt"
         loads.write_text(f"{len(lfs)}\n" + "".join(f"{lf!r}\n" for lf in lfs))
-        opts = launch.macros(self.plain, 3) + ["-DWITHSTRESSFIELDS=1"] + opts + ["-loads", str(loads), "-inc0", str(inc0)]
+        opts = launch.macros(self.plain, self.dim) + ["-DWITHSTRESSFIELDS=1"] + opts + ["-loads", str(loads), "-inc0", str(inc0)]
         if restart:
             opts += ["-restart", str(files.root / restart)]
         state.pending = list(lfs)
@@ -287,7 +319,7 @@ class Process:
             freefem.run(self.entry, opts, files.fem, ranks=work.numerics.ranks, timeout=work.numerics.timeout,
                         log=files.root / "freefem.log")
         finally:
-            accept(work, files, state, 3)
+            accept(work, files, state, self.dim)
             state.launches.append({"wall": time.perf_counter() - t0, "increments": len(state.accepted) - before,
                                    "complete": not state.pending})
         if state.pending:
@@ -325,14 +357,22 @@ class Process:
                           f"{row.get('nodes_outside_old_mesh', 0)} nodes extrapolated")
 
     def energy(self, mesh: dict, T: np.ndarray) -> float:
-        """Thermal energy of the body, int rho c (T - T_0) dV (J), exact for the P1 field."""
-        vol = remeshing.cell_volumes(mesh["points"], mesh["cells"])
-        return float(self.rho_c * vol @ transfer.nodes_to_cells(mesh["cells"], T - self.T0))
+        """Thermal energy of the body, int rho c (T - T_0) dV (J), exact for the P1 field (in (r, z):
+        2 pi int r (T - T_0) dA, with int_K r v = |K| / 12 (sum r_i sum v_i + sum r_i v_i) for P1 r and v)."""
+        cells = mesh["cells"]
+        if self.axi:
+            area = remeshing.cell_volumes(mesh["points"][:, :2], cells)
+            r, v = mesh["points"][cells, 0], (T - self.T0)[cells]
+            return float(self.rho_c * 2 * np.pi * area @ ((r.sum(1) * v.sum(1) + (r * v).sum(1)) / 12))
+        vol = remeshing.cell_volumes(mesh["points"], cells)
+        return float(self.rho_c * vol @ transfer.nodes_to_cells(cells, T - self.T0))
 
     def chips_heat(self, mesh: dict, T: np.ndarray, d0: float, d1: float) -> tuple[float, int]:
         """Heat content int rho c (T - T_0) dV of the slice the drill removes from d0 to d1 (J), on the old mesh."""
         pts, w = removed_slice_quadrature(d0, d1, self.block.diameter / 2, self.block.point_angle,
-                                          self.g.params.get("height", 0.03), self.axis)
+                                          self.g.params.get("height", 0.03), self.axis, n_theta=1 if self.axi else 48)
+        if self.axi:
+            pts = pts[:, [0, 2]]        # (r, 0, z) -> (r, z)
         if len(pts) == 0:
             return 0.0, 0
         vals, outside = transfer.transfer_nodal(mesh["points"], mesh["cells"], T - self.T0, pts)
@@ -340,13 +380,15 @@ class Process:
 
     @property
     def axis(self) -> tuple[float, float]:
-        return tuple(self.g.params.get("axis", (0.0, 0.0)))
+        return (0.0, 0.0) if self.axi else tuple(self.g.params.get("axis", (0.0, 0.0)))
 
     def record_probes(self, inc: int, row: dict, T: np.ndarray) -> None:
         if not self.block.probes:
             return
         names = [p.name for p in self.block.probes]
         pos = np.array([p.position for p in self.block.probes], dtype=float)
+        if self.axi:        # a thermocouple at (x, y, z) sits at r = hypot(x, y) of the section
+            pos = np.column_stack([np.hypot(pos[:, 0], pos[:, 1]), pos[:, 2]])
         inside = transfer.locate(self.mesh["points"], self.mesh["cells"], pos)[0] >= 0
         vals, _ = transfer.transfer_nodal(self.mesh["points"], self.mesh["cells"], T, pos)
         self.probes.append({"time": row["time"], **{n: float(v) if ok else float("nan")
@@ -354,7 +396,7 @@ class Process:
 
     def record_profile(self, inc: int, row: dict, d: Path) -> None:
         """Bore diameter error 2 u_r along the depth, and the stresses of the cells at the wall."""
-        prof = bore_profile(self.mesh, d, self.axis, self.g.params.get("height", 0.03), self.block.bore_bins)
+        prof = bore_profile(self.mesh, d, self.axis, self.g.params.get("height", 0.03), self.block.bore_bins, self.dim)
         if prof is not None:
             self.profiles.append({"increment": inc, "time": row["time"], "kind": row["kind"], **prof})
 
@@ -403,12 +445,36 @@ class Process:
                            "diameter_error_end_of_drilling": drilled[-1]["diameter_error"] if drilled else [],
                            "hoop_stress_after": last["hoop_stress"], "axial_stress_after": last["axial_stress"]}
         summary["drilling"] = out
+        summary["outputs"] = campaign_outputs(out, self.profiles)
         (root / "summary.json").write_text(json.dumps(summary, indent=1))
         (root / "drilling.json").write_text(json.dumps({**out, "steps": rows, "profiles": self.profiles}, indent=1))
         if self.scene.output.png:
             plots(root, rows, self.probes, self.profiles)
         self.progress(f"  heat in {heat_in:.4g} J = stored {d_energy:.4g} + chips {chips:.4g} - convection {conv:.4g}"
                       f" - thermoelastic {te:.3g}; mismatch {abs(mismatch) / scale:.2e} (transfer defect {defect:.3g} J)")
-        self.progress(f"  tables in {tables}, pictures and drilling.json in {root}")
+        pics = [n for n in ("probes.png", "bore.png", "energy.png") if (root / n).is_file()]
+        if pics:
+            self.progress(f"  pictures: {', '.join(str(root / n) for n in pics)}")
+        if self.probes:
+            self.progress(f"  probe histories (thermocouples): {tables / 'probes.csv'}")
+        self.progress(f"  per step: {tables / 'drilling-steps.csv'}; all steps and bore profiles: {root / 'drilling.json'}")
 
 
+
+
+def campaign_outputs(out: dict, profiles: list[dict]) -> dict:
+    """Scalars of a drilling run for a campaign's table (``wendel sweep`` reads summary.json["outputs"]): the peak
+    temperature of each thermocouple (K), the bore diameter error 2 u_r (m; mean over the depth bins and largest
+    magnitude) at the end of drilling and at the end of the run (after cooling), and the energy balance error."""
+    res = {f"peak_T_{name}": v for name, v in out.get("probes_peak", {}).items()}
+    drilled = [p for p in profiles if p["kind"] != "cool"]
+    for label, prof in (("end_of_drilling", drilled[-1] if drilled else None),
+                        ("after_cooling", profiles[-1] if profiles else None)):
+        if prof is None:
+            continue
+        d = np.array(prof["diameter_error"], dtype=float)
+        if np.isfinite(d).any():
+            res[f"bore_diameter_error_{label}"] = float(np.nanmean(d))
+            res[f"bore_diameter_error_max_{label}"] = float(d[np.nanargmax(np.abs(d))])
+    res["energy_balance_error"] = out["energy"]["balance_error"]
+    return res

@@ -11,7 +11,8 @@ from __future__ import annotations
 from ..meshes import LABELS
 from ..scene import petsc
 from ..scene import axisymmetric
-from ..scene.blocks import BLOCKS, PROBLEMS
+from ..scene.blocks import BLOCKS, PROBLEMS, discretization
+from ..scene.blocks.contact import in_current_configuration
 from ..scene.schema import ANALYTIC_REFERENCES, BODY_FORCES, Scene
 from .checkpoint import RunFiles
 
@@ -45,13 +46,15 @@ def macros(scene: Scene, dimension: int) -> list[str]:
     """
     if scene.problem != "mechanics":
         return [f"-D{m}=1" for m in PROBLEMS[scene.problem].macros]
-    switches = [f"-Ddimension={dimension}", f"-DPk={axisymmetric.element(scene, dimension) or ELEMENT}"]
+    element = discretization.element(scene) or axisymmetric.element(scene, dimension) or ELEMENT
+    switches = [f"-Ddimension={dimension}", f"-DPk={element}"]
+    switches += discretization.macros(scene)       # -DWITHDG=1: edp/lib/dg.idp
     switches += [f"-D{BLOCKS[name].macro}=1" for name in scene.blocks if BLOCKS[name].macro]
     # a switch that depends on a key rather than on a block goes here: switches.append("-DNAME=1") when on
     switches += axisymmetric.macros(scene, dimension)
     if scene.kinematics.updated_lagrangian:
         switches.append("-DUPDATEDLAGRANGIAN=1")     # edp/lib/kinematics.idp
-    if getattr(scene, "contact", None) is not None and scene.contact.current_configuration:
+    if getattr(scene, "contact", None) is not None and in_current_configuration(scene.contact, scene):
         switches.append("-DWITHFRICTION=1")      # friction, tool, path or force control: edp/lib/friction.idp
     if scene.numerics.solver == "petsc":
         switches.append("-DWITHPETSC=1")       # loads wendel's PETSc plugin (lib/petsc.idp)
@@ -83,6 +86,8 @@ def options(scene: Scene, files: RunFiles, dimension: int, segment: dict | None 
     v = list(bf.value) + [0.0] * (3 - len(bf.value))
     opts += ["-body_id", str(BODY_FORCES[bf.kind]), "-body_fx", repr(v[0]), "-body_fy", repr(v[1]),
              "-body_fz", repr(v[2])]
+    if scene.reference.probe:
+        opts += [v for a, c in zip("xyz", scene.reference.probe) for v in (f"-probe_{a}", repr(float(c)))]
     if scene.reference.analytic:
         opts += ["-ref_id", str(ANALYTIC_REFERENCES[scene.reference.analytic])]
     for name in scene.blocks:

@@ -23,8 +23,11 @@ RULES = {3: (np.array([[_A3, _B3, _B3, _B3], [_B3, _A3, _B3, _B3], [_B3, _B3, _A
          2: (np.array([[2 / 3, 1 / 6, 1 / 6], [1 / 6, 2 / 3, 1 / 6], [1 / 6, 1 / 6, 2 / 3]]), np.full(3, 1 / 3))}
 
 
-def conservative_transfer(old_points, old_cells, values, new_points, new_cells):
+def conservative_transfer(old_points, old_cells, values, new_points, new_cells, axisymmetric: bool = False):
     """Nodal field onto a new mesh by the lumped L2 projection ``v_i = int phi_i v_old / int phi_i``.
+
+    ``axisymmetric``: (r, z) triangles, every integral weighted by r (``v_i = int r phi_i v_old / int r phi_i``),
+    so the integral over the body of revolution ``2 pi int r v`` is the one kept.
 
     For P1 the integral of the result is ``sum_i v_i int phi_i``, i.e. the quadrature of ``int v_old`` over
     the new mesh: the heat the new body holds is the heat the old field had there (exact where the old
@@ -46,9 +49,12 @@ def conservative_transfer(old_points, old_cells, values, new_points, new_cells):
     vq, outside = transfer.transfer_nodal(old_points, old_cells, values, q)
     vq = vq.reshape(len(new_cells), len(w))
     vol = cell_volumes(pts, new_cells)
-    # int phi_j v over a cell: sum_q w_q |K| bary_qj v_q
-    contrib = vol[:, None] * np.einsum("q,qj,cq->cj", w, bary, vq)
-    mass = np.bincount(new_cells.ravel(), weights=np.repeat(vol / (dim + 1), dim + 1), minlength=len(pts))
+    # r at the quadrature points: the weight of (r, z) integrals (the rule is exact for r phi_j: degree 2)
+    rq = q[:, 0].reshape(len(new_cells), len(w)) if axisymmetric else np.ones((len(new_cells), len(w)))
+    # int phi_j v (r) over a cell: sum_q w_q |K| bary_qj v_q (r_q)
+    contrib = vol[:, None] * np.einsum("q,qj,cq->cj", w, bary, vq * rq)
+    cell_mass = vol[:, None] * np.einsum("q,qj,cq->cj", w, bary, rq)
+    mass = np.bincount(new_cells.ravel(), weights=cell_mass.ravel(), minlength=len(pts))
     load = np.bincount(new_cells.ravel(), weights=contrib.ravel(), minlength=len(pts))
     return load / mass, outside
 
@@ -56,6 +62,9 @@ def conservative_transfer(old_points, old_cells, values, new_points, new_cells):
 def removed_slice_quadrature(d0: float, d1: float, radius: float, point_angle: float, height: float,
                              axis=(0.0, 0.0), n_r: int = 6, n_s: int = 6, n_theta: int = 48):
     """Points (m) and weights (m^3) integrating over the slice B(d1) - B(d0) of the bore.
+
+    ``n_theta = 1`` gives the (r, z) rule of an axisymmetric section: the points (r, 0, z) and the weights of
+    the volume of revolution (2 pi r dr ds); take the columns 0 and 2.
 
     Gauss-Legendre in r on the pieces between the kinks of the profiles, in the depth s between the two
     profiles, and the trapezoidal rule in theta (exact for trigonometric polynomials). The weights sum to

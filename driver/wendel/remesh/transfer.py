@@ -35,22 +35,11 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
+from .quality import _as_arrays, signed_measure
+
 __all__ = ["locate", "transfer_nodal", "cell_to_nodes", "nodes_to_cells", "transfer_cell", "transfer_active_set"]
 
 
-def _prepare(points, cells):
-    cells = np.asarray(cells, dtype=np.int64)
-    dim = cells.shape[1] - 1
-    points = np.asarray(points, dtype=float)
-    if points.ndim == 1:
-        points = points.reshape(-1, dim)
-    return points[:, :dim], cells, dim
-
-
-def _measure(points, cells):
-    x0 = points[cells[:, 0]]
-    jac = np.stack([points[cells[:, i]] - x0 for i in range(1, cells.shape[1])], axis=-1)
-    return np.abs(np.linalg.det(jac)) / (2.0 if cells.shape[1] == 3 else 6.0)
 
 
 def _boundary(cells):
@@ -141,7 +130,7 @@ def locate(old_points, old_cells, new_points, tol=1e-9):
     bary : ndarray (p, d + 1)
         Barycentric coordinates in that element (clipped to >= 0 and renormalized).
     """
-    pts, cells, dim = _prepare(old_points, old_cells)
+    pts, cells, dim = _as_arrays(old_points, old_cells)
     q = np.asarray(new_points, dtype=float)
     q = q.reshape(-1, dim) if q.ndim == 1 else q[:, :dim]
     x0 = pts[cells[:, 0]]
@@ -230,7 +219,7 @@ def transfer_nodal(old_points, old_cells, values, new_points, tol=1e-9):
     >>> v.tolist(), out
     ([0.5, 1.0], 0)
     """
-    pts, cells, dim = _prepare(old_points, old_cells)
+    pts, cells, dim = _as_arrays(old_points, old_cells)
     vals, restore = _as_nodal(values, len(pts))
     q = np.asarray(new_points, dtype=float)
     q = q.reshape(-1, dim) if q.ndim == 1 else q[:, :dim]
@@ -272,11 +261,11 @@ def cell_to_nodes(points, cells, cell_values, method="volume", axisymmetric=Fals
     >>> cell_to_nodes(pts, [[0, 1, 2], [0, 2, 3]], [1.0, 3.0]).tolist()
     [2.0, 1.0, 2.0, 3.0]
     """
-    pts, cells, dim = _prepare(points, cells)
+    pts, cells, dim = _as_arrays(points, cells)
     v = np.asarray(cell_values, dtype=float)
     vv = v[:, None] if v.ndim == 1 else v
     n = len(pts)
-    vol = _measure(pts, cells)
+    vol = np.abs(signed_measure(pts, cells))
     if axisymmetric:
         vol = vol * (2 * np.pi * pts[cells, 0].mean(axis=1))
     npc = dim + 1

@@ -11,25 +11,37 @@ from ..meshes import LABELS
 from . import vtu as output
 
 
-def bore_profile(mesh: dict, inc_dir: Path, axis, height: float, bins: int) -> dict | None:
+def bore_profile(mesh: dict, inc_dir: Path, axis, height: float, bins: int, dim: int = 3) -> dict | None:
     """Along the depth: mean of 2 u_r at the bore-wall nodes (m) and of the hoop and axial stress (Pa) of
-    the cells touching the wall, in ``bins`` depth bins (NaN where a bin has no node)."""
+    the cells touching the wall, in ``bins`` depth bins (NaN where a bin has no node). ``dim = 2``: the
+    (r, z) section (x = r, y = z; u_r = u_x, hoop stress = stress_zz, axial = stress_yy)."""
     p, f, tags, cells = mesh["points"], mesh["facets"], mesh["tags"], mesh["cells"]
     wall = np.unique(f[tags == LABELS["bore_wall"]])
     if len(wall) == 0:
         return None
     name = "u_total.node.txt" if (inc_dir / "u_total.node.txt").is_file() else "u.node.txt"
-    u = output.read_array(inc_dir / name).reshape(-1, 3)
-    x, y = p[wall, 0] - axis[0], p[wall, 1] - axis[1]
-    r = np.hypot(x, y)
-    ur = (u[wall, 0] * x + u[wall, 1] * y) / r
-    s = height - p[wall, 2]
+    u = output.read_array(inc_dir / name).reshape(-1, dim)
+    if dim == 2:
+        ur, s = u[wall, 0], height - p[wall, 1]
+    else:
+        x, y = p[wall, 0] - axis[0], p[wall, 1] - axis[1]
+        r = np.hypot(x, y)
+        ur = (u[wall, 0] * x + u[wall, 1] * y) / r
+        s = height - p[wall, 2]
     edges = np.linspace(s.min(), s.max(), bins + 1)
     mid = 0.5 * (edges[1:] + edges[:-1])
     idx = np.clip(np.searchsorted(edges, s, side="right") - 1, 0, bins - 1)
     d_err = [float(np.mean(2 * ur[idx == i])) if np.any(idx == i) else float("nan") for i in range(bins)]
     hoop = axial = [float("nan")] * bins
-    if (inc_dir / "stress_xx.cell.txt").is_file():
+    if (inc_dir / "stress_xx.cell.txt").is_file() and dim == 2:
+        on_wall = np.isin(cells, wall).sum(axis=1) >= 2          # triangles with an edge on the wall
+        cs = height - p[cells[on_wall]].mean(axis=1)[:, 1]
+        cidx = np.clip(np.searchsorted(edges, cs, side="right") - 1, 0, bins - 1)
+        s_tt = output.read_array(inc_dir / "stress_zz.cell.txt")[on_wall]
+        s_zz = output.read_array(inc_dir / "stress_yy.cell.txt")[on_wall]
+        hoop = [float(np.mean(s_tt[cidx == i])) if np.any(cidx == i) else float("nan") for i in range(bins)]
+        axial = [float(np.mean(s_zz[cidx == i])) if np.any(cidx == i) else float("nan") for i in range(bins)]
+    elif (inc_dir / "stress_xx.cell.txt").is_file():
         on_wall = np.isin(cells, wall).sum(axis=1) >= 3          # cells with a face on the wall
         c = p[cells[on_wall]].mean(axis=1)
         cx, cy = c[:, 0] - axis[0], c[:, 1] - axis[1]

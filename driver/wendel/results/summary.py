@@ -174,12 +174,17 @@ def write_summary(root: Path, scene, state, dimension: int, picture: float | Non
 
 
 def warnings(state, scene) -> list[str]:
-    """Silent trouble of accepted increments: inverted elements in a deformed mesh that was not remeshed."""
+    """Silent trouble: a DG penalty below its stability bound; inverted elements in a deformed mesh that was
+    not remeshed."""
+    from ..scene.blocks.discretization import penalty_warnings
+
+    dg = getattr(scene, "discretization", None)
+    low = penalty_warnings(dg, 2) if dg is not None else []      # DG is 2D only
     inverted = sorted(inc for inc, q in state.quality.items() if q.get("inverted", 0) > 0)
     if not inverted:
-        return []
+        return low
     what = "no [remesh] table" if scene.remesh is None else "remeshing did not remove them"
-    return [f"increments {', '.join(map(str, inverted))}: the deformed mesh has inverted elements ({what}); "
+    return low + [f"increments {', '.join(map(str, inverted))}: the deformed mesh has inverted elements ({what}); "
             f"results there are not trustworthy"]
 
 

@@ -86,26 +86,26 @@ def check_node_order(vertices_txt: Path, points: np.ndarray) -> None:
                            f"({n} vs {len(points)}); the VTU would be wrong")
 
 
+def _per_entity(f: Path, suffix: str, n: int, what: str) -> tuple[str, np.ndarray, int]:
+    """The array of ``f`` (``NAME.node.txt`` / ``NAME.cell.txt``) as (name, values, components)."""
+    v = read_array(f)
+    if v.size % n:
+        raise ValueError(f"{f}: {v.size} values do not fit {n} {what}")
+    ncomp = v.size // n
+    return f.name.removesuffix(suffix), (v.reshape(n, ncomp) if ncomp > 1 else v), ncomp
+
+
 def increment_fields(inc_dir: Path, n_points: int, n_cells: int, dimension: int):
     """Point and cell data of one increment folder, shaped for meshio."""
     point_data, cell_data = {}, {}
     for f in sorted(inc_dir.glob("*.node.txt")):
-        name = f.name.removesuffix(".node.txt")
-        v = read_array(f)
-        if v.size % n_points:
-            raise ValueError(f"{f}: {v.size} values do not fit {n_points} nodes")
-        ncomp = v.size // n_points
-        v = v.reshape(n_points, ncomp) if ncomp > 1 else v
+        name, v, ncomp = _per_entity(f, ".node.txt", n_points, "nodes")
         if ncomp == 2 and dimension == 2:
             v = np.column_stack([v, np.zeros(n_points)])
         point_data[name] = v
     for f in sorted(inc_dir.glob("*.cell.txt")):
-        name = f.name.removesuffix(".cell.txt")
-        v = read_array(f)
-        if v.size % n_cells:
-            raise ValueError(f"{f}: {v.size} values do not fit {n_cells} cells")
-        ncomp = v.size // n_cells
-        cell_data[name] = [v.reshape(n_cells, ncomp) if ncomp > 1 else v]
+        name, v, _ = _per_entity(f, ".cell.txt", n_cells, "cells")
+        cell_data[name] = [v]
     return point_data, cell_data
 
 

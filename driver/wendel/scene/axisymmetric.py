@@ -45,7 +45,7 @@ def _heated_cylinder(scene) -> list[str]:
 REFERENCES: dict[str, Callable] = {"heated-cylinder": _heated_cylinder, "thick-sphere": _thick_sphere}
 
 
-AXI_BUILDERS = {"axi_rectangle", "sphere_section", "hollow_cylinder_section", "notched_bar"}
+AXI_BUILDERS = {"axi_rectangle", "sphere_section", "hollow_cylinder_section", "notched_bar", "drilled-section"}
 """Builders of (r, z) sections; the plane 2D builders work too when their x range is >= 0 (FreeFEM checks)."""
 
 

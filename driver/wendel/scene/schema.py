@@ -207,8 +207,8 @@ class Numerics(Strict):
 
 class Kinematics(Strict):
     """Small strain on the mesh of the last remesh, or updated-Lagrangian large deformation
-    (edp/lib/kinematics.idp: incremental logarithmic strain, polar rotation of the increment; 2D plane strain or
-    3D, P1)."""
+    (edp/lib/kinematics.idp: incremental logarithmic strain, polar rotation of the increment; 2D plane strain,
+    axisymmetric (r, z) or 3D, P1)."""
 
     kind: KinematicsName = Field("small-strain", description=f"one of {', '.join(KINEMATICS)}")
     min_area_ratio: float = Field(0.02, ge=0, lt=1, description="updated-Lagrangian: an increment that shrinks "
@@ -257,9 +257,18 @@ class Reference(Strict):
     errors: list[str] = Field(default_factory=list,
                               description="record.json keys of errors against closed forms, e.g. error_hertz_p0")
     quantity: str = Field("strain_energy", description="record.json quantity compared with the finest run")
+    probe: Optional[list[float]] = Field(None, min_length=2, max_length=3, description="point whose "
+                                         "displacement record.json gives as probe_ux, probe_uy(, probe_uz) [m]")
     compare: Optional[ComparisonName] = Field(
         None, description=f"another code's figures of the quantity, plotted by wendel study: {', '.join(COMPARISONS)}")
 
+
+    @field_validator("probe")
+    @classmethod
+    def _probe(cls, v):
+        if v is not None and not all(abs(c) < 1e30 for c in v):
+            raise ValueError(f"probe: coordinates must be finite numbers below 1e30 in size, got {v}")
+        return v
 
     @field_validator("errors")
     @classmethod
@@ -336,8 +345,9 @@ class SceneBase(Strict):
             if th is not None and not (th.coupling == "adiabatic" and th.alpha == 0):
                 raise ValueError("kinematics.kind = \"updated-lagrangian\" is not implemented with [thermal] except "
                                  "coupling = \"adiabatic\" with alpha = 0 (heating by plastic work, no expansion)")
-            if self.elasticity.plane != "strain":
-                raise ValueError("kinematics.kind = \"updated-lagrangian\" needs elasticity.plane = \"strain\"")
+            if self.elasticity.plane == "stress":
+                raise ValueError("kinematics.kind = \"updated-lagrangian\" needs elasticity.plane = \"strain\" "
+                                 "or \"axisymmetric\"")
         elif self.kinematics.initial_strain != [0.0, 0.0, 0.0]:
             raise ValueError("kinematics.initial_strain needs kinematics.kind = \"updated-lagrangian\"")
         if self.body_force.kind == "manufactured" and self.reference.analytic is None:

@@ -33,6 +33,8 @@ def row(root: Path, entry: dict) -> dict:
         r[k] = summary.get(k)
     for k, v in (summary.get("errors") or {}).items():
         r[k] = v
+    for k, v in (summary.get("outputs") or {}).items():      # a run's own scalar outputs (drilling: probes, bore)
+        r[k] = v
     for k, v in (summary.get("last_increment") or {}).items():
         if (isinstance(v, (int, float)) and not isinstance(v, bool) and k not in r
                 and not k.startswith(("time_", "error_", "reference_"))):     # errors: from summary["errors"]

@@ -146,6 +146,16 @@ def image_size(path: Path) -> tuple[int, int]:
     return w, h
 
 
+def in_current_configuration(block: Contact, scene) -> bool:
+    """Gap and normal in the current configuration (edp/lib/friction.idp, ``-DWITHFRICTION=1``): friction, a tool,
+    a path or force control; and any plane or ball obstacle of a plane or 3D updated-Lagrangian scene (without
+    friction: law none), whose body moves far from the launch mesh between remeshes (friction.idp has no
+    (r, z) weights: axisymmetric scenes keep contact.idp)."""
+    ul = scene is not None and scene.kinematics.updated_lagrangian and block.obstacle in ("plane", "ball", "tool") \
+        and scene.elasticity.plane != "axisymmetric"
+    return block.current_configuration or ul
+
+
 def options(block: Contact, scene, files) -> list[str]:
     """``-contact_*`` options of contact.idp (numbers, ids and the image path only)."""
     c = list(block.center) + [0.0] * (3 - len(block.center))
@@ -159,7 +169,7 @@ def options(block: Contact, scene, files) -> list[str]:
             "-contact_ref", str(REFERENCES.get(block.reference, 0))]
     if block.obstacle == "heightmap":
         opts += ["-contact_image", str(block.image_path)]
-    if block.current_configuration:
+    if in_current_configuration(block, scene):
         opts += friction_options(block, files)
     return opts
 

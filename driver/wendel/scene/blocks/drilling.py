@@ -30,7 +30,7 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 from . import Block, register
 
 H0 = 1e-3    # m: Kienzle's reference chip thickness (1 mm)
-DRILLED_BUILDERS = ("drilled-cylinder", "drilled-block")
+DRILLED_BUILDERS = ("drilled-cylinder", "drilled-block", "drilled-section")
 FORCE_MODELS = ("kienzle", "given")
 
 
@@ -127,8 +127,10 @@ def check(block: Drilling, scene) -> None:
     """A drilling scene needs a drilled-* builder, a thermal block with time, and a clamped base."""
     g = scene.geometry
     if g.builder not in DRILLED_BUILDERS:
-        raise ValueError(f"[drilling] needs geometry.builder one of {', '.join(DRILLED_BUILDERS)}, not {g.builder!r}"
-                         " (the axisymmetric drilled-section waits for the axisymmetric model)")
+        raise ValueError(f"[drilling] needs geometry.builder one of {', '.join(DRILLED_BUILDERS)}, not {g.builder!r}")
+    if (g.builder == "drilled-section") != (scene.elasticity.plane == "axisymmetric"):
+        raise ValueError("geometry.builder: the (r, z) section drilled-section goes with elasticity.plane = "
+                         "'axisymmetric', and an axisymmetric drilling scene needs drilled-section")
     given = sorted(set(g.model_extra or {}) & {"depth", "diameter", "point_angle", "h_bore", "grade"})
     if given:
         raise ValueError(f"geometry.{given[0]}: the drill and its bore come from [drilling], not [geometry]")

@@ -10,11 +10,15 @@ edp/lib/tool.idp; contact.py composes them into its table).
 from __future__ import annotations
 
 import math
+from pathlib import Path
 from typing import Optional
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
+from .. import stl
 from . import choice
+
+ROOT = Path(__file__).resolve().parents[4]
 
 FRICTION_LAWS = {"none": 0, "coulomb": 1, "tresca": 2}
 """Friction law name -> ``-fric_law`` id of friction.idp."""
@@ -43,16 +47,34 @@ class Friction(BaseModel):
 
 
 class Tool(BaseModel):
-    """A rigid 2D tool: a counter-clockwise polygon at load factor 0 whose corners are rounded by radii
-    (a cutting tool: rake face, flank face and the edge radius at their corner)."""
+    """A rigid tool at load factor 0: in 2D a counter-clockwise polygon whose corners are rounded by radii
+    (a cutting tool: rake face, flank face and the edge radius at their corner); in 3D a closed triangulated
+    surface from an STL file (validated by wendel.scene.stl: closed, oriented, finite)."""
 
     model_config = ConfigDict(extra="forbid", validate_assignment=True)
 
-    vertices: list[list[float]] = Field(..., description="polygon vertices [[x, y], ...], counter-clockwise [m]")
+    vertices: Optional[list[list[float]]] = Field(None, description="2D: polygon vertices [[x, y], ...], counter-clockwise [m]")
     radii: Optional[list[float]] = Field(None, description="corner radius of each vertex, 0 = sharp [m]; default all 0")
+    stl: Optional[str] = Field(None, description="3D: a closed surface as an STL file (ASCII or binary, coordinates in m at "
+                                                 "load factor 0), relative to the repository root")
+
+    @property
+    def stl_path(self) -> Path:
+        p = Path(self.stl or "")
+        return p if p.is_absolute() else ROOT / p
 
     @model_validator(mode="after")
     def _shape(self):
+        if (self.vertices is None) == (self.stl is None):
+            raise ValueError("contact.tool needs either vertices (a 2D polygon) or stl (a 3D surface), not both")
+        if self.stl is not None:
+            if self.radii is not None:
+                raise ValueError("contact.tool.radii belong to a polygon (vertices), not to an STL surface")
+            try:
+                stl.table(stl.read(self.stl_path), str(self.stl_path))
+            except ValueError as e:
+                raise ValueError(f"contact.tool.stl: {e}") from None
+            return self
         v = self.vertices
         if len(v) < 3 or any(len(p) != 2 for p in v):
             raise ValueError("contact.tool.vertices: at least 3 points [x, y]")
@@ -66,7 +88,8 @@ class Tool(BaseModel):
 
 class ToolPath(BaseModel):
     """The tool's rigid motion as piecewise-linear functions of the load factor (extrapolated linearly past
-    the ends): translation (x, y) and rotation about contact.center; added to contact.displacement."""
+    the ends): translation (x, y, z) and rotation about the axis through contact.center (2D: z); added to
+    contact.displacement."""
 
     model_config = ConfigDict(extra="forbid", validate_assignment=True)
 
@@ -74,7 +97,8 @@ class ToolPath(BaseModel):
     x: Optional[list[float]] = Field(None, description="translation along x at those load factors [m]; default 0")
     y: Optional[list[float]] = Field(None, description="translation along y at those load factors [m]; default 0")
     z: Optional[list[float]] = Field(None, description="translation along z at those load factors (3D) [m]; default 0")
-    angle: Optional[list[float]] = Field(None, description="rotation about contact.center, counter-clockwise (2D) [deg]; default 0")
+    angle: Optional[list[float]] = Field(None, description="rotation about the axis through contact.center, counter-clockwise [deg]; default 0")
+    axis: Optional[list[float]] = Field(None, description="the rotation axis [ax, ay, az] (3D; normalised) [1]; default [0, 0, 1] (2D: z only)")
 
     @model_validator(mode="after")
     def _lengths(self):
@@ -85,6 +109,8 @@ class ToolPath(BaseModel):
             val = getattr(self, key)
             if val is not None and len(val) != n:
                 raise ValueError(f"contact.path.{key} needs {n} values (one per load factor)")
+        if self.axis is not None and (len(self.axis) != 3 or not math.hypot(*self.axis) > 1e-12):
+            raise ValueError("contact.path.axis: three components [ax, ay, az], not all zero")
         return self
 
     def rows(self) -> list[tuple[float, float, float, float, float]]:
@@ -110,7 +136,12 @@ def friction_options(block, files) -> list[str]:
         p = files.tables / "tool_path.txt"
         p.write_text(f"{len(rows)}\n" + "".join(" ".join(repr(float(v)) for v in r) + "\n" for r in rows))
         opts += ["-tool_path", str(p)]
-    if block.tool is not None:
+        if block.path.axis is not None:
+            a = block.path.axis
+            opts += ["-tool_axis_x", repr(float(a[0])), "-tool_axis_y", repr(float(a[1])), "-tool_axis_z", repr(float(a[2]))]
+    if block.tool is not None and block.tool.stl is not None:
+        opts += ["-tool_stl", str(stl.write_table(block.tool.stl_path, files.tables / "tool_triangles.txt"))]
+    elif block.tool is not None:
         v = block.tool.vertices
         radii = block.tool.radii or [0.0] * len(v)
         p = files.tables / "tool_polygon.txt"

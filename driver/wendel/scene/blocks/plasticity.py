@@ -3,7 +3,7 @@
 Hardening laws go through a registry of names to the integer ids of ``-plast_law``:
 
 >>> sorted(LAWS.items(), key=lambda kv: kv[1])
-[('perfect', 0), ('linear', 1), ('step42', 1), ('johnson-cook', 2)]
+[('perfect', 0), ('linear', 1), ('step42', 1), ('johnson-cook', 2), ('voce', 3)]
 >>> Plasticity(law="linear", sigma0=250e6, H=1e9).law
 'linear'
 
@@ -27,7 +27,7 @@ from pydantic import BaseModel, ConfigDict, Field, field_validator, model_valida
 
 from . import Block, register
 
-LAWS = {"perfect": 0, "linear": 1, "johnson-cook": 2, "step42": 1}
+LAWS = {"perfect": 0, "linear": 1, "johnson-cook": 2, "step42": 1, "voce": 3}
 """Hardening law name -> ``-plast_law`` id of plasticity.idp (``step42`` is ``linear`` in step-42's units)."""
 
 
@@ -38,14 +38,17 @@ def step42_to_von_mises(sigma0: float, gamma: float, E: float, nu: float) -> tup
 
 
 class Plasticity(BaseModel):
-    """Von Mises plasticity: perfect, linear isotropic hardening or Johnson-Cook."""
+    """Von Mises plasticity: perfect, linear isotropic hardening, Johnson-Cook or Voce (saturation plus linear:
+    sigma_y = sigma0 + H p + (voce_sigma_inf - sigma0)(1 - exp(-voce_delta p)))."""
 
     model_config = ConfigDict(extra="forbid", validate_assignment=True)
 
     law: str = Field("perfect", description=f"hardening law: {', '.join(LAWS)}")
-    sigma0: Optional[float] = Field(None, gt=0, description="initial yield stress, perfect and linear (von Mises); step42: of |dev sigma| [Pa]")
+    sigma0: Optional[float] = Field(None, gt=0, description="initial yield stress, perfect, linear and voce (von Mises); step42: of |dev sigma| [Pa]")
     gamma: float = Field(0.0, ge=0, lt=1, description="step42 law: hardening parameter of deal.II step-42 [1]")
-    H: float = Field(0.0, ge=0, description="linear isotropic hardening modulus d sigma_y / d p [Pa]")
+    H: float = Field(0.0, ge=0, description="linear isotropic hardening modulus d sigma_y / d p (linear; the linear term of voce) [Pa]")
+    voce_sigma_inf: Optional[float] = Field(None, gt=0, description="voce law: saturation stress sigma_inf of the exponential term, >= sigma0 [Pa]")
+    voce_delta: float = Field(0.0, ge=0, description="voce law: saturation exponent delta, (sigma_inf - sigma0)(1 - exp(-delta p)) [1]")
     jc_A: Optional[float] = Field(None, gt=0, description="Johnson-Cook yield stress A [Pa]")
     jc_B: float = Field(0.0, ge=0, description="Johnson-Cook hardening modulus B [Pa]")
     jc_n: float = Field(1.0, gt=0, description="Johnson-Cook hardening exponent n [1]")
@@ -71,8 +74,10 @@ class Plasticity(BaseModel):
     def _parameters(self):
         if self.reference not in (None, "hill"):
             raise ValueError(f"unknown plasticity reference {self.reference!r}; valid: hill")
-        if self.law in ("perfect", "linear", "step42") and self.sigma0 is None:
+        if self.law in ("perfect", "linear", "step42", "voce") and self.sigma0 is None:
             raise ValueError(f"plasticity.law = {self.law!r} needs sigma0")
+        if self.law == "voce" and (self.voce_sigma_inf is None or self.voce_sigma_inf < self.sigma0):
+            raise ValueError("plasticity.law = 'voce' needs voce_sigma_inf >= sigma0")
         if self.law == "johnson-cook":
             if self.jc_A is None:
                 raise ValueError("plasticity.law = 'johnson-cook' needs jc_A")
@@ -95,6 +100,8 @@ def options(block: Plasticity, scene, files) -> list[str]:
         opts += ["-plast_sigma0", repr(sigma0)]
     if block.jc_A is not None:
         opts += ["-plast_jc_A", repr(block.jc_A)]
+    if block.law == "voce":
+        opts += ["-plast_voce_sinf", repr(block.voce_sigma_inf), "-plast_voce_delta", repr(block.voce_delta)]
     if block.temperature is not None:
         opts += ["-plast_T", repr(block.temperature)]
     if block.reference == "hill":

@@ -25,7 +25,7 @@ from ...meshes import LABELS
 COUPLINGS = {"monolithic": 0, "staggered": 1, "adiabatic": 2}
 CouplingName = choice(COUPLINGS, "coupling")
 """Coupling name -> ``-therm_coupling`` id of thermal.idp."""
-SOURCES = {"none": 0, "uniform": 1, "manufactured": 2}
+SOURCES = {"none": 0, "uniform": 1, "manufactured": 2, "moving": 3}
 """Heat source kind -> ``-therm_source_id`` id of thermal.idp."""
 
 
@@ -57,6 +57,18 @@ class ThermalBoundary(BaseModel):
         return 2, self.h, self.T_inf
 
 
+class MovingSource(BaseModel):
+    """A heat source moving at constant velocity: a Gaussian ``Q exp(-|x - c(t)|^2 / s^2) / (pi^(d/2) s^d)``,
+    ``c(t) = start + velocity t`` (d = 2 in a plane 2D model, 3 in 3D and on the axis of an (r, z) model)."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    power: float = Field(..., gt=0, description="power of the source [W] (W/m in a plane 2D model)")
+    radius: float = Field(..., gt=0, description="Gaussian radius s of the source [m]")
+    start: list[float] = Field(..., min_length=2, max_length=3, description="centre at t = 0 (x, y[, z]) [m]")
+    velocity: list[float] = Field(..., min_length=2, max_length=3, description="velocity (vx, vy[, vz]) [m/s]")
+
+
 class Thermal(BaseModel):
     """Heat conduction with thermal expansion, Gough-Joule coupling and plastic (Taylor-Quinney) heating."""
 
@@ -76,6 +88,7 @@ class Thermal(BaseModel):
     mms_amplitude: float = Field(1.0, description="amplitude of the manufactured temperature T_ref + lf A phi [K]")
     tool_temperature: Optional[float] = Field(None, gt=0, description="temperature of the contact tool [K]; default T_ref")
     contact_conductance: float = Field(0.0, ge=0, description="heat transfer coefficient through the active contact zone [W/m^2/K]")
+    moving_source: Optional[MovingSource] = Field(None, description="a heat source moving at constant velocity ([thermal.moving_source])")
 
 
     @field_validator("boundary")
@@ -96,6 +109,8 @@ class Thermal(BaseModel):
 
     @property
     def source_kind(self) -> str:
+        if self.moving_source is not None:
+            return "moving"
         if self.source == "manufactured":
             return "manufactured"
         return "uniform" if self.source != 0 else "none"
@@ -110,6 +125,20 @@ def options(block: Thermal, scene, files) -> list[str]:
         raise ValueError("thermal.source = \"manufactured\" needs reference.analytic = \"manufactured-sine\" "
                          "and body_force.kind = \"manufactured\"")
     plast = getattr(scene, "plasticity", None)
+    opts_ms = []
+    ms = block.moving_source
+    if ms is not None:
+        if block.source != 0:
+            raise ValueError("thermal.moving_source and thermal.source: give one heat source")
+        axi = scene.elasticity.plane == "axisymmetric"
+        if axi and (ms.start[0] != 0 or ms.velocity[0] != 0):
+            raise ValueError("thermal.moving_source in an (r, z) model: the source moves along the axis "
+                             "(start = [0, z], velocity = [0, v])")
+        dim = 3 if axi or len(ms.start) == 3 else 2
+        c, v = list(ms.start) + [0.0], list(ms.velocity) + [0.0]
+        opts_ms = ["-therm_ms_q", repr(ms.power), "-therm_ms_s", repr(ms.radius), "-therm_ms_dim", str(dim)]
+        for k, a, b in zip("xyz", c, v):
+            opts_ms += [f"-therm_ms_{k}0", repr(float(a)), f"-therm_ms_v{k}", repr(float(b))]
     if plast is not None and plast.load_time not in (0.0, block.duration):
         raise ValueError(f"plasticity.load_time ({plast.load_time:g} s) and thermal.duration "
                          f"({block.duration:g} s) are two clocks of one process: make them equal")
@@ -126,7 +155,7 @@ def options(block: Thermal, scene, files) -> list[str]:
             "-therm_r", repr(0.0 if block.source == "manufactured" else float(block.source)),
             "-therm_mms_amp", repr(block.mms_amplitude),
             "-therm_tool_T", repr(block.tool_temperature if block.tool_temperature is not None else block.T_ref),
-            "-therm_contact_h", repr(block.contact_conductance)]
+            "-therm_contact_h", repr(block.contact_conductance)] + opts_ms
     return opts
 
 

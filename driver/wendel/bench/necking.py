@@ -1,0 +1,95 @@
+"""Benchmark of the necking bar (``wendel bench necking``): Simo's round bar in tension (updated-Lagrangian,
+axisymmetric, Voce saturation hardening) on three meshes; force-elongation, neck radius and cost.
+
+The peak force is checked against Considere's condition for a uniform bar (d sigma_y / d eps = sigma_y, the
+elastic strain neglected): the bar's peak lies between the Considere force of its smallest section (at the
+imperfection, radius 0.982 R) and that of the full section.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import shutil
+from pathlib import Path
+
+import numpy as np
+
+from .. import loop as runmod
+from ..results import vtu as output
+from ..scene import load
+from . import WORKFLOWS, register
+
+R0 = 6.413e-3              # m, radius of the bar (Simo 1988)
+
+
+def voce(p: float, s0=450e6, h=129.24e6, sinf=715e6, delta=16.93) -> tuple[float, float]:
+    """sigma_y(p) and its slope (Pa) of the necking bar's saturation law."""
+    e = math.exp(-delta * p)
+    return s0 + h * p + (sinf - s0) * (1 - e), h + (sinf - s0) * delta * e
+
+
+def considere(radius: float) -> tuple[float, float]:
+    """(log strain, force in N) at the peak of a uniform bar of this radius: sigma_y'(eps) = sigma_y(eps)."""
+    lo, hi = 0.0, 2.0
+    for _ in range(200):                  # bisection on sigma_y' - sigma_y, decreasing
+        mid = (lo + hi) / 2
+        s, ds = voce(mid)
+        lo, hi = (mid, hi) if ds > s else (lo, mid)
+    s, _ = voce(lo)
+    return lo, s * math.pi * radius ** 2 * math.exp(-lo)
+
+
+def curve(root: Path) -> list[dict]:
+    """Per accepted increment: elongation of the whole bar (m), end force (N), neck and end radii (m)."""
+    rows = []
+    for d in sorted((root / "fem").glob("inc-*")):
+        rec = json.loads((d / "record.json").read_text())
+        pos = output.read_array(d / "position.node.txt").reshape(-1, 2)
+        X = pos - output.read_array(d / "u_total.node.txt").reshape(-1, 2) if (d / "u_total.node.txt").is_file() \
+            else pos - output.read_array(d / "u.node.txt").reshape(-1, 2)
+        mid, top = np.abs(X[:, 1]) < 1e-9, np.abs(X[:, 1] - X[:, 1].max()) < 1e-9
+        rows.append({"elongation": 2 * (pos[top, 1].max() - X[:, 1].max()), "force": rec["reaction_y_4"],
+                     "neck_radius": pos[mid, 0].max(), "end_radius": pos[top, 0].max(),
+                     "newton": rec.get("newton_iterations", 0)})
+    return rows
+
+
+def at(rows: list[dict], key: str, elongation: float) -> float:
+    """``key`` interpolated at an elongation (m) of the curve."""
+    e = [r["elongation"] for r in rows]
+    return float(np.interp(elongation, e, [r[key] for r in rows])) if e and e[-1] >= elongation - 1e-12 else math.nan
+
+
+@register("necking")
+def necking_bench(quick: bool, workdir: Path) -> list[dict]:
+    """workflows/ul-necking-bar.toml at three mesh sizes (h outside the neck zone, h_neck in it; --quick: the
+    two coarser); 70 increments to 14 mm."""
+    levels = [(2.0e-3, 0.8e-3), (1.0e-3, 0.4e-3), (0.5e-3, 0.2e-3)]
+    if quick:
+        levels = levels[:2]
+    path = WORKFLOWS / "ul-necking-bar.toml"
+    _, f_full = considere(R0)
+    eps_c, f_neck = considere(0.982 * R0)
+    rows = []
+    for h, hn in levels:
+        scene = load(path)
+        scene.geometry.h = h
+        scene.geometry.params["refine"]["h"] = hn
+        scene.output.png = False
+        scene.output.vtu = False
+        out = workdir / f"h{h * 1e3:g}mm"
+        shutil.rmtree(out, ignore_errors=True)
+        runmod.run_scene(scene, path, out, progress=lambda *_: None)
+        s = json.loads((out / "summary.json").read_text())
+        c = curve(out)
+        peak = max(c, key=lambda r: r["force"])
+        rows.append({"h_mm": h * 1e3, "h_neck_mm": hn * 1e3, "dofs": s["dofs"], "increments": s["increments"],
+                     "newton_iterations": s["newton_iterations"], "wall_s": round(s["wall_time"], 2),
+                     "peak_force_kN": peak["force"] / 1e3, "peak_at_mm": peak["elongation"] * 1e3,
+                     "considere_neck_kN": f_neck / 1e3, "considere_full_kN": f_full / 1e3,
+                     **{f"r_neck/R0_{e:g}mm": at(c, "neck_radius", e * 1e-3) / R0 for e in (7, 10, 14)},
+                     "force_14mm_kN": at(c, "force", 14e-3) / 1e3,
+                     "r_end/R0_14mm": at(c, "end_radius", 14e-3) / R0})
+        (workdir / f"curve-h{h * 1e3:g}mm.json").write_text(json.dumps(c))
+    return rows
