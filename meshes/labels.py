@@ -23,6 +23,7 @@ LABELS = {
     "machined": 22,      # orthogonal cutting: the machined surface behind the tool
     "bore_wall": 23,   # cylindrical wall of a drilled bore (meshes/drilling.py)
     "bore_bottom": 24,  # tip cone at the bottom of a drilled bore
+    "layer_end": 25,   # orthogonal cutting: the far end of the cut layer (left of the uncut layer, free)
     "domain": 100,  # the body itself
 }
 

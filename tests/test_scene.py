@@ -111,13 +111,13 @@ def test_values_reach_freefem_as_numbers_only(tmp_path):
     path the driver wrote."""
     from conftest import WORKFLOWS
     from wendel.loop import RunFiles, options
-    from wendel.scene.blocks.cutting import FE_READY
+    from wendel.cutting.fe import fe_scene
     from wendel.scene.schema import SOLVERS
 
     for path in sorted(WORKFLOWS.glob("*.toml")):
         scene = load(path)
-        if scene.cutting is not None and not FE_READY:
-            continue    # a cut has no FE options until the chip formation exists (tests/test_cutting.py)
+        if scene.cutting is not None:
+            scene = fe_scene(scene)     # a cut runs the mechanics scene it derives (wendel.cutting.fe)
         files = RunFiles(tmp_path / path.stem)
         opts = options(scene, files, 3 if scene.geometry.builder == "box" else 2)
         values = opts[1::2]

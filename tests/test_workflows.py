@@ -5,7 +5,6 @@ import json
 import pytest
 
 from wendel.loop import StepCutError, run
-from wendel.scene.blocks.cutting import FE_READY
 
 from conftest import WORKFLOWS
 
@@ -14,8 +13,6 @@ SCENES = sorted(p.name for p in WORKFLOWS.glob("*.toml"))
 
 @pytest.mark.parametrize("name", SCENES)
 def test_scene_runs_at_smoke_size(name, tmp_path):
-    if name.startswith("cutting-") and not FE_READY:
-        pytest.skip("FE chip formation not built yet (issue 17); tests/test_cutting.py runs its analytic model")
     out = tmp_path / "run"
     try:
         run(WORKFLOWS / name, smoke=True, out=out, png=False, progress=lambda *_: None)

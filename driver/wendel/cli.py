@@ -77,7 +77,8 @@ def main(argv: list[str] | None = None) -> int:
                    "  sweep, thermal, ul,\n"
                    "  necking (Simo's necking bar on 3 meshes),\n"
                    "  oxley, oxley-domain, oxley-kienzle (the analytic orthogonal cut);\n"
-                   "only when named: step42-dealii, overhead, gmsh3d")
+                   "only when named: step42-dealii, overhead, gmsh3d,\n"
+                   "  cutting, cutting-isothermal (the FE orthogonal cut, about 4 minutes each)")
     p.add_argument("--quick", action="store_true", help="small sizes only")
 
     p = sub.add_parser("sweep", help="campaigns: a plan of runs, locally or on SLURM (see wendel.sweep)")

@@ -55,6 +55,10 @@ def run(scene_path: str | Path, smoke: bool = False, ranks: int | None = None, o
             return _execute(scene, files, state, progress)
     scene_path = Path(scene_path)
     scene = load(scene_path, smoke=smoke)
+    if getattr(scene, "cutting", None) is not None:     # an orthogonal cut: the FE scene it derives (issue 17)
+        from ..cutting.fe_run import run_cut
+        return run_cut(scene, scene_path, Path(out) if out else _new_run_dir(scene_path, smoke), smoke, progress,
+                       frames=png is not False)
     if scale is not None:
         scene.geometry.h *= scale
         refine = (scene.geometry.model_extra or {}).get("refine")

@@ -341,8 +341,10 @@ class SceneBase(Strict):
         if self.kinematics.updated_lagrangian:
             if self.problem != "mechanics":
                 raise ValueError("kinematics.kind = \"updated-lagrangian\" is for mechanics scenes")
-            if getattr(self, "thermal", None) is not None:
-                raise ValueError("kinematics.kind = \"updated-lagrangian\" is not implemented with [thermal]")
+            th = getattr(self, "thermal", None)
+            if th is not None and not (th.coupling == "adiabatic" and th.alpha == 0):
+                raise ValueError("kinematics.kind = \"updated-lagrangian\" is not implemented with [thermal] except "
+                                 "coupling = \"adiabatic\" with alpha = 0 (heating by plastic work, no expansion)")
             if self.elasticity.plane == "stress":
                 raise ValueError("kinematics.kind = \"updated-lagrangian\" needs elasticity.plane = \"strain\" "
                                  "or \"axisymmetric\"")

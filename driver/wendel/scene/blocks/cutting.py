@@ -7,8 +7,9 @@ material comes from the scene's other tables: Johnson-Cook constants from ``[pla
 ``johnson-cook``), density, conductivity and heat capacity from ``[thermal]`` (at ``properties_T0``).
 
 ``wendel oxley SCENE.toml`` runs the analytic model from these tables. The finite-element chip
-formation (updated-Lagrangian kinematics, frictional polygon tool) is not built yet: ``wendel run`` of a
-cutting scene stops with a message saying so (:data:`FE_READY`).
+formation: ``wendel run`` of a cutting scene solves the mechanics scene that :mod:`wendel.cutting.fe`
+derives from it (updated-Lagrangian kinematics, frictional polygon tool, Johnson-Cook, remeshing; an
+isothermal prototype, :data:`FE_READY`).
 
 >>> c = Cutting(speed=200 / 60, uncut_thickness=0.15e-3, width=1.6e-3, rake=-7.0)
 >>> c.clearance, c.oxley.properties
@@ -23,8 +24,8 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from . import Block, choice, register
 
-FE_READY = False
-"""Whether the finite-element chip formation exists (issue 17; needs issues 14 and 15)."""
+FE_READY = True
+"""Whether the finite-element chip formation exists: an isothermal prototype (:mod:`wendel.cutting.fe`)."""
 
 PROPERTY_TEMPERATURES = ("shear-plane", "chip", "interface")
 PropertyTemperature = choice(PROPERTY_TEMPERATURES, "property temperature")
@@ -68,6 +69,10 @@ class Cutting(BaseModel):
     properties_T0: float = Field(273.15, gt=0, description="temperature at which thermal.k and thermal.c hold [K]")
     k_slope: float = Field(0.0, description="dk/dT of the work material [W/m/K^2]")
     c_slope: float = Field(0.0, description="dc/dT of the work material [J/kg/K^2]")
+    cut_length: Optional[float] = Field(None, gt=0, description="FE: length of cut, the tool's travel over the "
+                                        "load factor 0 -> 1 [m]; default 2 uncut_thickness")
+    remesh_every: int = Field(4, ge=0, le=1000, description="FE: remesh the deformed workpiece after every this "
+                              "many increments (0: only when the element quality falls below 0.1) [1]")
     oxley: OxleyConstants = OxleyConstants()
 
     @model_validator(mode="after")
@@ -81,10 +86,9 @@ class Cutting(BaseModel):
 
 
 def options(block: Cutting, scene, files) -> list[str]:
-    """The FE options of the cut: refused until the chip formation exists (see :data:`FE_READY`)."""
-    raise ValueError("the finite-element chip formation of a [cutting] scene needs updated-Lagrangian "
-                     "kinematics and a frictional polygon tool, which are not merged yet (issue 17); "
-                     "`wendel oxley SCENE.toml` gives the analytic prediction of the same cut")
+    """No FreeFEM options: ``wendel run`` solves the mechanics scene :func:`wendel.cutting.fe.fe_scene`
+    derives from the cutting scene (this block is not in it)."""
+    raise ValueError("a [cutting] scene is run through wendel.cutting.fe (wendel run SCENE.toml), not as a block")
 
 
 def check(block: Cutting, scene) -> None:

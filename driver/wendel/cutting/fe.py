@@ -1,0 +1,148 @@
+"""The finite-element cut of a ``[cutting]`` scene: the mechanics scene that ``wendel run`` solves.
+
+A cutting scene describes the process (``[cutting]``), the work material (``[plasticity]``, Johnson-Cook)
+and the workpiece (``orthogonal-cutting`` builder). :func:`fe_scene` turns it into a plain mechanics scene
+of modules that exist and are tested on their own:
+
+- updated-Lagrangian kinematics, 2D plane strain (``edp/lib/kinematics.idp``);
+- the tool as a rigid rounded polygon (rake face, edge radius, flank face; ``edp/lib/tool.idp``) moving
+  in -x by ``cutting.cut_length`` over the load factor 0 -> 1, Coulomb friction ``cutting.friction`` on
+  the whole ``free_surface`` (top of the layer and the step face; ``edp/lib/friction.idp``), capped at
+  ``cutting.shear_cap`` when given;
+- Johnson-Cook plasticity with its rate term (time per unit load factor = cut length / speed) and, when
+  ``thermal.coupling = "adiabatic"``, its thermal softening: the temperature is an internal variable of the
+  quadrature points heated by beta (Taylor-Quinney) of the plastic work (``edp/lib/thermal.idp``'s
+  adiabatic coupling, allowed with updated-Lagrangian kinematics when alpha = 0: the thermal expansion is
+  left out, and so is the frictional heat, which has no heat equation to enter). Other couplings: the cut
+  is isothermal (at T_room; conduction with UL is not written);
+- a remesh of the deformed body every ``cutting.remesh_every`` increments (and whenever the element
+  quality falls below 0.1), uniform size ``geometry.fine * geometry.h``, with transfer of the UL state
+  (``ul_eps``) and the plastic state (``wendel.remesh``).
+
+**Units.** The FE scene is written in mm, MPa, N, s and K (forces per unit width in N/mm, energy mJ, so
+rho c in mJ/mm^3/K = 1e-6 J/m^3/K and k unchanged): FreeFEM refuses
+meshes with element areas below 1e-8 ("bug : mes < 1e-8 !", measured: a 25 um element is 6e-10 m^2).
+:func:`forces` converts back to N for the width b.
+
+No material separation criterion: the material splits at the rounded edge by flowing around it (the
+stagnation point), and the mesh follows through remeshing (the DEFORM / PFEM way, issue 17 item 2).
+
+>>> from wendel.freefem import ROOT
+>>> from wendel.scene import load
+>>> fe = fe_scene(load(ROOT / "workflows" / "cutting-aisi1045.toml", smoke=True))
+>>> fe.kinematics.kind, fe.contact.obstacle, fe.contact.friction.mu, fe.geometry.model_extra["uncut"]
+('updated-lagrangian', 'tool', 0.5, 0.15)
+"""
+
+from __future__ import annotations
+
+import inspect
+import math
+
+import numpy as np
+
+from ..meshes.cutting import orthogonal_cutting
+from ..scene.schema import Scene
+from .tool import tool_polygon
+
+MM = 1e3          # m -> mm
+MPA = 1e-6        # Pa -> MPa
+GAP = 0.02        # the tool starts this fraction of h in front of the step face
+
+
+def tool_at_start(cutting, x_step: float) -> dict:
+    """The tool polygon in mm at load factor 0: sharp vertices (rake top, edge, flank end, back) with the
+    edge radius as the corner radius of the edge vertex, its lowest point on the machined level y = 0 and
+    its leftmost point inside the layer ``GAP * h`` in front of the step face at ``x_step`` [mm].
+    Also the tip (lowest point) and the rake direction, for the outputs."""
+    h, r = cutting.uncut_thickness * MM, cutting.edge_radius * MM
+    rake, clearance = math.radians(cutting.rake), math.radians(cutting.clearance)
+    sharp = tool_polygon(rake, clearance, 0.0, (cutting.rake_length or 6 * cutting.uncut_thickness) * MM,
+                         (cutting.flank_length or 4 * cutting.uncut_thickness) * MM).vertices
+    t_rake = np.array([math.sin(rake), math.cos(rake)])
+    t_flank = np.array([math.cos(clearance), math.sin(clearance)])
+    wedge = math.pi / 2 - rake - clearance
+    bisector = (t_rake + t_flank) / np.linalg.norm(t_rake + t_flank)
+    centre = bisector * r / math.sin(wedge / 2) if r > 0 else np.zeros(2)
+    lowest = centre[1] - r if r > 0 else 0.0
+    x_rake_at_h = (h - (-lowest)) * t_rake[0] / t_rake[1]          # the rake face (through the origin) at y = h
+    left = min(centre[0] - r, x_rake_at_h) if r > 0 else min(0.0, x_rake_at_h)
+    shift = np.array([x_step + GAP * h - left, -lowest])
+    radii = [0.0] * len(sharp)
+    radii[1] = r
+    tip = (centre + shift - [0.0, r]) if r > 0 else shift
+    return {"vertices": (sharp + shift).tolist(), "radii": radii, "tip": tip.tolist(),
+            "rake_dir": t_rake.tolist(), "edge": (shift + [0.0, 0.0]).tolist()}
+
+
+def fe_scene(scene, travel: float = 1.0) -> Scene:
+    """The mechanics scene (mm, MPa, N) of the FE cut of a validated cutting scene; ``travel`` scales the
+    cut length (a smoke run is the first increments of the full cut: its steps over the full steps)."""
+    c, g = scene.cutting, scene.geometry
+    extra = dict(g.model_extra or {})
+    length_keys = ("length", "depth", "uncut", "pre_cut")
+    geometry = {"builder": g.builder, "h": g.h * MM, **{k: v for k, v in extra.items() if k not in length_keys}}
+    for k in length_keys:
+        if k in extra:
+            geometry[k] = float(extra[k]) * MM
+    defaults = {k: q.default for k, q in inspect.signature(orthogonal_cutting).parameters.items()
+                if q.default is not inspect.Parameter.empty}      # the builder's, for keys the scene leaves out
+    length = float(extra.get("length", defaults["length"])) * MM
+    pre_cut = float(extra.get("pre_cut", defaults["pre_cut"])) * MM
+    fine = float(extra.get("fine", defaults["fine"]))
+    tool = tool_at_start(c, length - pre_cut)
+    cut = travel * (c.cut_length if c.cut_length is not None else 2 * c.uncut_thickness) * MM
+    p = scene.plasticity
+    plasticity = {"law": "johnson-cook", "jc_A": p.jc_A * MPA, "jc_B": p.jc_B * MPA, "jc_n": p.jc_n,
+                  "jc_C": p.jc_C, "jc_rate0": p.jc_rate0, "jc_m": p.jc_m, "jc_T_room": p.jc_T_room,
+                  "jc_T_melt": p.jc_T_melt, "load_time": cut / MM / c.speed}
+    friction = {"law": "coulomb", "mu": c.friction}
+    if c.shear_cap is not None:
+        friction["tau_max"] = c.shear_cap * MPA
+    steps = scene.loading.steps
+    every = c.remesh_every
+    # the re-equilibration after a remesh is an increment too: the k-th remesh follows increment k (every + 1) - 1
+    # (a step cut shifts the later ones by one increment)
+    at = [k * (every + 1) - 1 for k in range(1, (steps - 1) // every + 1)] if every else []
+    # uniform size fine * h (graded on p down to half of it at the edge, the isothermal cut stopped at 40 um
+    # instead of 92.5, measured: "mesh would invert" after the second remesh)
+    remesh = {"at": at, "indicator": "", "h": fine * g.h * MM, "max_remeshes": len(at) + 20}
+    boundary = {}
+    for name, b in scene.boundary.items():
+        d = b.model_dump(exclude_none=True)
+        for key in ("ux", "uy"):
+            if key in d:
+                d[key] = d[key] * MM
+        boundary[name] = d
+    data = {
+        "description": f"FE cut (mm, MPa, N): {scene.description}",
+        "geometry": geometry,
+        "material": {"E": scene.material.E * MPA, "nu": scene.material.nu},
+        "elasticity": {"plane": "strain"},
+        "plasticity": plasticity,
+        "kinematics": {"kind": "updated-lagrangian"},
+        "boundary": boundary,
+        "contact": {"boundary": "free_surface", "normal": "+y", "obstacle": "tool",
+                    "tool": {"vertices": tool["vertices"], "radii": tool["radii"]}, "friction": friction,
+                    "path": {"load_factors": [0.0, 1.0], "x": [0.0, -cut], "y": [0.0, 0.0]}},
+        "loading": {"steps": steps, "max_cuts": scene.loading.max_cuts},
+        # newton_maxit: the adiabatic temperature is a fixed point outside the tangent (linear convergence,
+        # factor about 0.5 an iteration, measured): 40 iterations stopped a re-equilibration at 55 um
+        "numerics": {"solver": "direct", "newton_tol": 1e-8, "newton_maxit": 100},
+        "output": {"png": False, "vtu": True},
+        "remesh": remesh,
+    }
+    th = scene.thermal
+    if th is not None and th.coupling == "adiabatic":      # heating by plastic work at the quadrature points
+        data["thermal"] = {"k": th.k, "rho": th.rho * 1e-6, "c": th.c, "alpha": 0.0, "T_ref": th.T_ref,
+                           "beta": th.beta, "coupling": "adiabatic", "duration": plasticity["load_time"]}
+        if th.T_initial is not None:
+            data["thermal"]["T_initial"] = th.T_initial
+    return Scene.model_validate(data)
+
+
+def forces(record: dict, width: float) -> tuple[float, float]:
+    """Cutting and thrust force [N] on the tool of width ``width`` [m] from a record of the FE scene (the
+    tool's force on the body, N/mm, is ``contact_force_x/y``; the body's on the tool is its opposite)."""
+    b = width * MM
+    return -float(record["contact_force_x"]) * b, -float(record["contact_force_y"]) * b

@@ -1,0 +1,60 @@
+"""One PNG frame of an FE cut: the deformed workpiece near the tool, coloured by the equivalent plastic
+strain, with the tool (its rounded edge drawn as arcs) at its place on the path."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+
+def rounded_outline(vertices, radii, per_arc: int = 16) -> np.ndarray:
+    """The outline of a polygon whose corners are rounded by ``radii`` (the tool of ``edp/lib/tool.idp``)."""
+    v = np.asarray(vertices, dtype=float)
+    n, out = len(v), []
+    for i in range(n):
+        r = radii[i]
+        if r <= 0:
+            out.append(v[i])
+            continue
+        a, b = v[i - 1] - v[i], v[(i + 1) % n] - v[i]
+        a, b = a / np.linalg.norm(a), b / np.linalg.norm(b)
+        half = math.acos(np.clip(a @ b, -1, 1)) / 2
+        centre = v[i] + (a + b) / np.linalg.norm(a + b) * r / math.sin(half)
+        p0, p1 = v[i] + a * r / math.tan(half), v[i] + b * r / math.tan(half)
+        t0, t1 = math.atan2(*(p0 - centre)[::-1]), math.atan2(*(p1 - centre)[::-1])
+        sweep = (t1 - t0 + math.pi) % (2 * math.pi) - math.pi      # the short way round, through the corner
+        for t in t0 + np.linspace(0.0, sweep, per_arc):
+            out.append(centre + r * np.array([math.cos(t), math.sin(t)]))
+    return np.array(out)
+
+
+def frame(path: Path, points, cells, p_cells, tool: dict, shift, title: str, h: float) -> Path:
+    """Write the frame ``path`` (positions in mm; ``p_cells`` the cells' equivalent plastic strain or None)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.tri import Triangulation
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tip = np.array(tool["tip"]) + shift
+    fig, ax = plt.subplots(figsize=(7, 5))
+    tri = Triangulation(points[:, 0], points[:, 1], cells)
+    if p_cells is not None:
+        pc = ax.tripcolor(tri, facecolors=np.asarray(p_cells).ravel(), cmap="viridis", vmin=0,
+                          vmax=max(float(np.max(p_cells)), 1e-6))
+        fig.colorbar(pc, ax=ax, label="equivalent plastic strain")
+    ax.triplot(tri, lw=0.2, color="k", alpha=0.4)
+    outline = rounded_outline(tool["vertices"], tool["radii"]) + shift
+    ax.fill(*outline.T, color="#7a7a7a", alpha=0.85)
+    ax.set_xlim(tip[0] - 5 * h, tip[0] + 3 * h)
+    ax.set_ylim(tip[1] - 2.5 * h, tip[1] + 4 * h)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [mm]")
+    ax.set_ylabel("y [mm]")
+    ax.set_title(title, fontsize=8)
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+    return path

@@ -1,0 +1,123 @@
+"""Run the FE cut of a cutting scene and report it per increment: forces, chip, contact, frames.
+
+``wendel run workflows/cutting-*.toml`` comes here (:func:`run_cut`): the mechanics scene of
+:func:`wendel.cutting.fe.fe_scene` is solved like any other (its run folder, VTU series, remeshes), then
+:func:`report` reads each increment's VTU (updated Lagrangian: the points are the current positions, mm)
+and record and writes ``cutting.csv`` and ``cutting.json`` in the run folder, and ``frames/inc-NNNN.png``:
+
+- ``Fc_N``, ``Ft_N``: cutting and thrust force on the tool for the width b [N] (:func:`wendel.cutting.fe.forces`);
+- ``chip_rise_m``: how far the highest material point stands above the top of the uncut layer [m] (0 before
+  any chip forms; the chip test's measure);
+- ``contact_length_m``: the largest distance from the tool tip, along the rake face, of a node in contact
+  (``friction_state`` > 0) [m];
+- ``chip_thickness_m``: :func:`wendel.cutting.chip.chip_thickness` of the free boundary nodes above 1.1 h
+  and between 1 and 2 h up the rake face from the tip (NaN while the chip is shorter than that);
+- ``tool_travel_m``, ``max_plastic_strain``, ``max_temperature_K`` (adiabatic cuts; NaN otherwise), ``elements``.
+
+``cutting.json`` adds the Oxley prediction of the same scene (``wendel oxley``) and the last increment's
+values beside it.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+
+from . import chip
+from .fe import MM, fe_scene, forces, tool_at_start
+
+COLUMNS = ["increment", "load_factor", "tool_travel_m", "Fc_N", "Ft_N", "chip_rise_m", "contact_length_m",
+           "chip_thickness_m", "max_plastic_strain", "max_temperature_K", "elements"]
+
+
+def run_cut(scene, scene_path: Path, out: Path, smoke: bool, progress=print, frames: bool = True) -> Path:
+    """Solve the FE cut of the validated cutting ``scene`` into ``out``; report it (see the module)."""
+    from ..loop.quasistatic import run_scene
+    from ..scene import load
+    travel = scene.loading.steps / load(scene_path).loading.steps if smoke else 1.0
+    try:
+        root = Path(run_scene(fe_scene(scene, travel), scene_path, out, smoke, progress))
+    except Exception:
+        root = Path(out).resolve()
+        if (root / "history.csv").is_file():       # a cut that stops: its accepted increments are reported
+            report(root, scene, frames=frames, travel=travel)
+        raise
+    rows = report(root, scene, frames=frames, travel=travel)
+    if rows:
+        r = rows[-1]
+        progress(f"  cut {r['tool_travel_m'] * 1e3:.4g} mm: F_c = {r['Fc_N']:.4g} N, F_t = {r['Ft_N']:.4g} N, "
+                 f"chip rise {r['chip_rise_m'] * 1e3:.4g} mm, contact length {r['contact_length_m'] * 1e3:.4g} mm "
+                 f"(cutting.csv, frames/)")
+    return root
+
+
+def _boundary_nodes(cells: np.ndarray) -> np.ndarray:
+    from ..remesh.mesher import boundary_facets
+    return np.unique(boundary_facets(cells))
+
+
+def measure(points: np.ndarray, cells: np.ndarray, state: np.ndarray, tip: np.ndarray, rake: float,
+            h: float) -> dict:
+    """Chip rise, contact length and chip thickness [mm] of one increment (positions in mm)."""
+    along = np.array([math.sin(rake), math.cos(rake)])
+    rise = max(float(points[:, 1].max()) - h, 0.0)
+    active = state > 0.5
+    length = float(((points[active] - tip) @ along).max()) if active.any() else 0.0
+    free = _boundary_nodes(cells)
+    free = free[~active[free] & (points[free, 1] > 1.1 * h)]      # the chip's back surface: risen above the layer
+    try:
+        thickness, _ = chip.chip_thickness(points[free], tip, rake, (h, 2 * h))
+    except ValueError:
+        thickness = float("nan")
+    return {"chip_rise": rise, "contact_length": max(length, 0.0), "chip_thickness": thickness}
+
+
+def report(root: Path, scene, frames: bool = True, travel: float = 1.0) -> list[dict]:
+    """Per-increment cutting outputs of the run folder ``root`` (see the module); returns the rows."""
+    import meshio
+    c = scene.cutting
+    h, rake = c.uncut_thickness * MM, math.radians(c.rake)
+    fe = fe_scene(scene, travel)
+    extra = fe.geometry.model_extra
+    start = tool_at_start(c, extra["length"] - extra["pre_cut"])
+    tip0 = np.array(start["tip"])
+    history = list(csv.DictReader((root / "history.csv").open()))
+    rows = []
+    for rec in history:
+        inc = int(rec["increment"])
+        vtu_path = root / "vtu" / f"inc-{inc:04d}.vtu"
+        if not vtu_path.is_file():
+            continue
+        m = meshio.read(vtu_path)
+        points = m.points[:, :2]
+        cells = m.cells_dict["triangle"]
+        shift = np.array([float(rec.get("tool_x") or 0.0), float(rec.get("tool_y") or 0.0)])
+        got = measure(points, cells, np.asarray(m.point_data["friction_state"]).ravel(), tip0 + shift, rake, h)
+        fc, ft = forces(rec, c.width)
+        rows.append({"increment": inc, "load_factor": float(rec["load_factor"]), "tool_travel_m": -shift[0] / MM,
+                     "Fc_N": fc, "Ft_N": ft, "chip_rise_m": got["chip_rise"] / MM,
+                     "contact_length_m": got["contact_length"] / MM, "chip_thickness_m": got["chip_thickness"] / MM,
+                     "max_plastic_strain": float(rec.get("max_plastic_strain") or 0.0),
+                     "max_temperature_K": float(rec.get("max_temperature") or "nan"),
+                     "elements": int(float(rec["elements"]))})
+        if frames:
+            from .fe_frames import frame
+            frame(root / "frames" / f"inc-{inc:04d}.png", points, cells, m.cell_data.get("p"), start, shift,
+                  f"{scene.description[:70]}\nincrement {inc}: travel {-shift[0] * 1e3:.1f} um, "
+                  f"F_c {fc:.0f} N, F_t {ft:.0f} N", h)
+    with (root / "cutting.csv").open("w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=COLUMNS)
+        w.writeheader()
+        w.writerows(rows)
+    summary = {"last": rows[-1] if rows else None, "width_m": c.width, "adiabatic": fe.thermal is not None}
+    try:
+        from .scene import predict, row
+        summary["oxley"] = row(predict(scene))
+    except (ValueError, ArithmeticError) as exc:         # outside the model's domain: say so, keep the FE
+        summary["oxley"] = {"refused": str(exc)}
+    (root / "cutting.json").write_text(json.dumps(summary, indent=1, default=float))
+    return rows
