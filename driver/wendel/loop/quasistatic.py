@@ -27,7 +27,7 @@ from ..scene.schema import Scene
 from .checkpoint import RunFiles, State, committed, save as _save_checkpoint
 from . import overlap
 from .guard import disk_full as _disk_full, guarded
-from .resume import restart, resume as resume_run
+from .resume import is_drilling, restart, resume as resume_run, resume_drilling
 from .launch import entry_script, macros, options, write_tables
 from .progress import _Progress
 from .steps import cut_step, grow_step, plan_step
@@ -45,8 +45,8 @@ def run(scene_path: str | Path, smoke: bool = False, ranks: int | None = None, o
     """
     if resume is not None:
         root = Path(resume).resolve()
-        if _drilling(root):
-            return _resume_drilling(root, progress)
+        if is_drilling(root):
+            return resume_drilling(root, progress)
         if not (root / "checkpoint.json").is_file() and (root / "scene.resolved.json").is_file():
             return restart(root, progress)
         with guarded(root):
@@ -71,26 +71,6 @@ def run(scene_path: str | Path, smoke: bool = False, ranks: int | None = None, o
             scene.numerics.solver = "ffddm"      # first: the schema refuses other solvers on several ranks
         scene.numerics.ranks = ranks
     return run_scene(scene, scene_path, Path(out) if out else _new_run_dir(scene_path, smoke), smoke, progress)
-
-
-def _resume_drilling(root: Path, progress) -> Path:
-    """A drilling run goes on after its last completed removal step; stopped before its first, it starts again."""
-    from . import drilling, drilling_state
-
-    if not drilling_state.resumable(root):
-        return restart(root, progress)
-    scene = Scene.model_validate(json.loads((root / "scene.resolved.json").read_text()))
-    smoke = bool(json.loads((root / "provenance.json").read_text()).get("smoke", False))
-    with guarded(root):
-        return drilling.run(scene, root / "scene.toml", root, smoke, progress, resume=True)
-
-
-def _drilling(root: Path) -> bool:
-    """Whether the run folder holds a drilling run (its resolved scene has a [drilling] table)."""
-    try:
-        return json.loads((root / "scene.resolved.json").read_text()).get("drilling") is not None
-    except (OSError, ValueError):
-        return False
 
 
 def run_scene(scene: Scene, scene_path: Path, out: Path, smoke: bool = False, progress=print) -> Path:

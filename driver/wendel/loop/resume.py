@@ -1,6 +1,6 @@
 """Continuing a run from its folder: from the last checkpoint (accepting what FreeFEM committed after it,
 finishing an interrupted re-equilibration, stopping a FreeFEM launch that outlived its driver), or from the
-start when it stopped before its first checkpoint.
+start when it stopped before its first checkpoint; a drilling run after its last completed removal step.
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ from pathlib import Path
 from ..results import summary
 from ..scene.schema import Scene
 from .checkpoint import RunFiles, State, load_state, save as _save_checkpoint
-from .guard import stop_leftovers
+from .guard import guarded, stop_leftovers
 
 
 def restart(root: Path, progress) -> Path:
@@ -56,3 +56,21 @@ def resume(root: Path, progress=print) -> tuple[RunFiles, Scene, State]:
     return files, scene, state
 
 
+def resume_drilling(root: Path, progress) -> Path:
+    """A drilling run goes on after its last completed removal step; stopped before its first, it starts again."""
+    from . import drilling, drilling_state
+
+    if not drilling_state.resumable(root):
+        return restart(root, progress)
+    scene = Scene.model_validate(json.loads((root / "scene.resolved.json").read_text()))
+    smoke = bool(json.loads((root / "provenance.json").read_text()).get("smoke", False))
+    with guarded(root):
+        return drilling.run(scene, root / "scene.toml", root, smoke, progress, resume=True)
+
+
+def is_drilling(root: Path) -> bool:
+    """Whether the run folder holds a drilling run (its resolved scene has a [drilling] table)."""
+    try:
+        return json.loads((root / "scene.resolved.json").read_text()).get("drilling") is not None
+    except (OSError, ValueError):
+        return False
