@@ -38,3 +38,44 @@ def edit(text: str, old: str, new: str) -> str:
     """``text`` with its first ``old`` replaced by ``new`` (which must be there: a test edits what it means to)."""
     assert old in text, old
     return text.replace(old, new, 1)
+
+
+# The material and drilling process of the drilling tests (grey cast iron, a 4 mm drill): scene text to follow
+# each test's [geometry] and boundary tables; ``{extra}`` takes the test's own [drilling] keys.
+IRON = """[material]
+E = 110e9                # Pa
+nu = 0.26                # 1
+"""
+IRON_THERMAL = """k = 48.0                 # W/m/K
+rho = 7200.0             # kg/m^3
+c = 500.0                # J/kg/K
+alpha = 11.7e-6          # 1/K
+"""
+
+
+def drill_table(h_bore: float) -> str:
+    """The [drilling] and [output] tables of the drilling tests (``{extra}`` left for str.format)."""
+    return f"""[drilling]
+diameter = 0.004         # m
+feed = 0.1e-3            # m
+speed = 2000.0           # 1/min
+force = "given"
+torque = 1.0             # N m
+eta_w = 0.3              # 1
+h_bore = {h_bore}          # m
+{{extra}}
+[output]
+png = false
+"""
+
+
+def drill(tmp_path, template: str, extra: str, name: str):
+    """Run the drilling scene ``template`` with the [drilling] keys ``extra``; (run folder, summary's drilling)."""
+    import json
+
+    from wendel.loop import run
+
+    scene = tmp_path / f"{name}.toml"
+    scene.write_text(template.format(extra=extra))
+    root = run(scene, out=tmp_path / name, progress=lambda *_: None)
+    return root, json.loads((root / "summary.json").read_text())["drilling"]

@@ -13,6 +13,8 @@ from wendel.meshes import LABELS
 from wendel.meshes import drilling as D
 from wendel.remesh.step import cell_volumes
 
+from conftest import IRON, IRON_THERMAL, drill, drill_table
+
 R, DIA, ANGLE = 0.003, 0.006, 118.0
 
 
@@ -81,41 +83,20 @@ x = [-0.008, 0.008]      # m
 y = [-0.008, 0.008]      # m
 height = 0.012           # m
 h = 0.005                # m
-[material]
-E = 110e9                # Pa
-nu = 0.26                # 1
-[boundary.bottom]
+""" + IRON + """[boundary.bottom]
 ux = 0.0                 # m
 uy = 0.0                 # m
 uz = 0.0                 # m
 [thermal]
-k = 48.0                 # W/m/K
-rho = 7200.0             # kg/m^3
-c = 500.0                # J/kg/K
-alpha = 11.7e-6          # 1/K
-coupling = "staggered"
+""" + IRON_THERMAL + """coupling = "staggered"
 [thermal.boundary.top]
 h = 10.0                 # W/m^2/K
 T_inf = 293.15           # K
-[drilling]
-diameter = 0.004         # m
-feed = 0.1e-3            # m
-speed = 2000.0           # 1/min
-force = "given"
-torque = 1.0             # N m
-eta_w = 0.3              # 1
-h_bore = 0.0015          # m
-{extra}
-[output]
-png = false
-"""
+""" + drill_table(0.0015)
 
 
 def _drill(tmp_path, extra, name="d"):
-    scene = tmp_path / f"{name}.toml"
-    scene.write_text(DRILL_SCENE.format(extra=extra))
-    root = run(scene, out=tmp_path / name, progress=lambda *_: None)
-    return root, json.loads((root / "summary.json").read_text())["drilling"]
+    return drill(tmp_path, DRILL_SCENE, extra, name)
 
 
 def test_drill_that_does_not_advance_is_a_heated_disc(tmp_path):

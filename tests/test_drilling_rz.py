@@ -11,6 +11,8 @@ import pytest
 from wendel.loop import run
 from wendel.meshes import drilling as D
 
+from conftest import IRON, IRON_THERMAL, drill, drill_table
+
 R, ANGLE = 0.002, 118.0
 
 RZ_SCENE = """
@@ -22,18 +24,11 @@ height = 0.012           # m
 h = 0.003                # m
 [elasticity]
 plane = "axisymmetric"
-[material]
-E = 110e9                # Pa
-nu = 0.26                # 1
-[boundary.bottom]
+""" + IRON + """[boundary.bottom]
 ux = 0.0                 # m
 uy = 0.0                 # m
 [thermal]
-k = 48.0                 # W/m/K
-rho = 7200.0             # kg/m^3
-c = 500.0                # J/kg/K
-alpha = 11.7e-6          # 1/K
-coupling = "monolithic"
+""" + IRON_THERMAL + """coupling = "monolithic"
 [thermal.boundary.top]
 h = 10.0                 # W/m^2/K
 T_inf = 293.15           # K
@@ -42,25 +37,11 @@ h = 10.0                 # W/m^2/K
 T_inf = 293.15           # K
 [numerics]
 solver = "direct"
-[drilling]
-diameter = 0.004         # m
-feed = 0.1e-3            # m
-speed = 2000.0           # 1/min
-force = "given"
-torque = 1.0             # N m
-eta_w = 0.3              # 1
-h_bore = 0.0005          # m
-{extra}
-[output]
-png = false
-"""
+""" + drill_table(0.0005)
 
 
 def _drill(tmp_path, extra, name="rz"):
-    scene = tmp_path / f"{name}.toml"
-    scene.write_text(RZ_SCENE.format(extra=extra))
-    root = run(scene, out=tmp_path / name, progress=lambda *_: None)
-    return root, json.loads((root / "summary.json").read_text())["drilling"]
+    return drill(tmp_path, RZ_SCENE, extra, name)
 
 
 def test_rz_drilling_energy_identity_and_removed_volume(tmp_path):
