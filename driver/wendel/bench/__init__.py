@@ -24,6 +24,17 @@ OPT_IN = {"step42-dealii", "overhead", "gmsh3d", "cutting", "cutting-isothermal"
 every scene (twice with WENDEL_BENCH_BASE); the FE cuts take about 4 minutes each, the whole 3D deep bore (``drilling-3d``) about 7."""
 
 
+def run_fresh(scene, path: Path, out: Path, smoke: bool = False) -> dict:
+    """Run the validated ``scene`` (read from ``path``) quietly into ``out``, emptied first; its summary.json."""
+    import shutil
+
+    from ..loop import run_scene
+
+    shutil.rmtree(out, ignore_errors=True)
+    run_scene(scene, path, out, smoke=smoke, progress=lambda *_: None)
+    return json.loads((out / "summary.json").read_text())
+
+
 def register(name: str):
     """Register a benchmark ``func(quick, workdir) -> rows`` under ``name``."""
 

@@ -15,15 +15,13 @@ from __future__ import annotations
 
 import json
 import math
-import shutil
 from pathlib import Path
 
 import numpy as np
 
-from .. import loop as runmod
 from ..scene import load
 from ..scene.blocks.discretization import Discretization
-from . import WORKFLOWS, register
+from . import WORKFLOWS, register, run_fresh
 
 COOK_REFERENCE = 16.432584376299037
 """u_y at (48, 52) of Cook's membrane with lambda = 7500, G = 0.375, total shear 1 (P. Krysl, FinEALE
@@ -46,9 +44,7 @@ def _run(path: Path, method: str, h: float, out: Path, solver: str = "direct") -
         scene.discretization = None
         scene.elasticity.order = order
     scene.output.png = False
-    shutil.rmtree(out, ignore_errors=True)
-    runmod.run_scene(scene, path, out, progress=lambda *_: None)
-    s = json.loads((out / "summary.json").read_text())
+    s = run_fresh(scene, path, out)
     rec = json.loads(sorted((out / "fem").glob("inc-*/record.json"))[-1].read_text())
     ph = s["wall_time_by_phase"]
     return {"dofs": rec["dofs"], "wall_time": s["wall_time"], "work_time": ph["assembly"] + ph["linear_solve"],

@@ -23,23 +23,19 @@ from __future__ import annotations
 import csv
 import json
 import math
-import shutil
 import time
 from pathlib import Path
 
-from . import WORKFLOWS, register
+from . import WORKFLOWS, register, run_fresh
 
 K_3D = 3
 """Removal steps of the 3D deep bore that are run (of 50)."""
 
 
 def _run(scene, path: Path, out: Path) -> tuple[Path, dict, float]:
-    from ..loop import run_scene
-
-    shutil.rmtree(out, ignore_errors=True)
     t0 = time.perf_counter()
-    root = run_scene(scene, path, out, progress=lambda *_: None)
-    return root, json.loads((root / "summary.json").read_text()), time.perf_counter() - t0
+    summary = run_fresh(scene, path, out)
+    return out, summary, time.perf_counter() - t0
 
 
 def _step_rows(case: str, root: Path) -> list[dict]:

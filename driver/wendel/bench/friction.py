@@ -10,11 +10,9 @@ Coulomb mu = 0.3 by friction.idp in the current configuration), the sliding bloc
 
 from __future__ import annotations
 
-import json
-import shutil
 from pathlib import Path
 
-from . import register
+from . import register, run_fresh
 from ..scene.blocks.contact import Friction
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -37,7 +35,6 @@ CASES = [
 def bench_friction(quick: bool, workdir: Path) -> list[dict]:
     """One row per (scene, variant): increments, Newton iterations, wall time and their ratios to the first
     (frictionless) variant of the scene."""
-    from ..loop import run_scene
     from ..scene import load
 
     rows, base = [], {}
@@ -51,9 +48,7 @@ def bench_friction(quick: bool, workdir: Path) -> list[dict]:
         elif friction is not None:
             scene.contact.friction = Friction(**friction)
         out = workdir / f"{k}-{name}"
-        shutil.rmtree(out, ignore_errors=True)
-        run_scene(scene, path, out, smoke=quick, progress=lambda *_: None)
-        s = json.loads((out / "summary.json").read_text())
+        s = run_fresh(scene, path, out, smoke=quick)
         last = s["last_increment"]
         row = {"scene": name, "variant": variant, "dofs": s["dofs"], "increments": s["increments"],
                "newton_iterations": s["newton_iterations"], "wall_time": round(s["wall_time"], 3),

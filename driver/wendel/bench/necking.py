@@ -10,15 +10,13 @@ from __future__ import annotations
 
 import json
 import math
-import shutil
 from pathlib import Path
 
 import numpy as np
 
-from .. import loop as runmod
 from ..results import vtu as output
 from ..scene import load
-from . import WORKFLOWS, register
+from . import WORKFLOWS, register, run_fresh
 
 R0 = 6.413e-3              # m, radius of the bar (Simo 1988)
 
@@ -79,9 +77,7 @@ def necking_bench(quick: bool, workdir: Path) -> list[dict]:
         scene.output.png = False
         scene.output.vtu = False
         out = workdir / f"h{h * 1e3:g}mm"
-        shutil.rmtree(out, ignore_errors=True)
-        runmod.run_scene(scene, path, out, progress=lambda *_: None)
-        s = json.loads((out / "summary.json").read_text())
+        s = run_fresh(scene, path, out)
         c = curve(out)
         peak = max(c, key=lambda r: r["force"])
         rows.append({"h_mm": h * 1e3, "h_neck_mm": hn * 1e3, "dofs": s["dofs"], "increments": s["increments"],

@@ -3,13 +3,10 @@ Newton iteration against small strain on the same mesh and load path."""
 
 from __future__ import annotations
 
-import json
-import shutil
 from pathlib import Path
 
-from .. import loop as runmod
 from ..scene import load
-from . import WORKFLOWS, register
+from . import WORKFLOWS, register, run_fresh
 
 
 @register("ul")
@@ -42,9 +39,7 @@ def ul_bench(quick: bool, workdir: Path) -> list[dict]:
             scene.output.png = False
             scene.output.vtu = False
             out = workdir / f"{dim}-h{h:g}-{kind}"
-            shutil.rmtree(out, ignore_errors=True)
-            runmod.run_scene(scene, path, out, progress=lambda *_: None)
-            s = json.loads((out / "summary.json").read_text())
+            s = run_fresh(scene, path, out)
             ph = s["wall_time_by_phase"]
             work = ph["assembly"] + ph["linear_solve"] + ph["constitutive"]
             tag = "ss" if kind == "small-strain" else "ul"
