@@ -184,7 +184,8 @@ def warnings(state, scene) -> list[str]:
     from ..scene.blocks.discretization import penalty_warnings
 
     dg = getattr(scene, "discretization", None)
-    low = penalty_warnings(dg, 2) if dg is not None else []      # DG is 2D only
+    dim = 3 if scene.geometry.builder == "box" or scene.geometry.dimension == 3 else 2
+    low = penalty_warnings(dg, dim) if dg is not None else []
     inverted = sorted(inc for inc, q in state.quality.items() if q.get("inverted", 0) > 0)
     if not inverted:
         return low
