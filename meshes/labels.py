@@ -24,6 +24,7 @@ LABELS = {
     "bore_wall": 23,   # cylindrical wall of a drilled bore (meshes/drilling.py)
     "bore_bottom": 24,  # tip cone at the bottom of a drilled bore
     "layer_end": 25,   # orthogonal cutting: the far end of the cut layer (left of the uncut layer, free)
+    "opened": 31,      # DG separation: both sides of the faces a separating run opened (separated.msh)
     "domain": 100,  # the body itself
 }
 

@@ -147,10 +147,33 @@ def test_a_killed_dg_plastic_run_resumes_to_the_same_result(tmp_path):
     np.testing.assert_allclose(np.array(last(tmp_path / "ref"), float), np.array(last(killed), float), rtol=1e-9, atol=1e-14)
 
 
+CONTINUE = """description = "the separated notched plate continued with CG: a pressure opens the cut"
+[geometry]
+mesh = "{mesh}"
+dimension = 2
+[material]
+E = 200e9                # Pa
+nu = 0.3                 # 1
+[elasticity]
+plane = "strain"
+[boundary.bottom]
+ux = 0.0                 # m
+uy = 0.0                 # m
+[boundary.top]
+ux = 0.0                 # m
+uy = 0.0                 # m
+[boundary.opened]
+pressure = 1e8           # Pa
+[numerics]
+solver = "direct"
+"""
+
+
 @pytest.mark.parametrize("h", [0.1, 0.07])
 def test_the_notched_plate_separates_across_its_ligament_and_the_force_drops(tmp_path, scene_file, quiet, h):
     # measured: h = 0.1 m: 1 face open at load factor 0.4 (the notch tip), 39 at 0.5, the force from 1.69e8 to
     # 3.6e7 N/m; h = 0.07 m: 35 faces at 0.4, the force from 1.27e8 to 2.8e7, then 0 (fully apart) at 0.5
+    import meshio
     import numpy as np
 
     from wendel.results.vtu import read_array, read_mesh
@@ -170,6 +193,31 @@ def test_the_notched_plate_separates_across_its_ligament_and_the_force_drops(tmp
     near = np.abs(centre[opened, 1] - 1.0) < 0.3                     # the ligament behind the notch tip at y = 1
     assert near.mean() > 0.9, centre[opened]
     assert centre[opened, 0].min() < 0.3 and centre[opened, 0].max() > 0.9   # from the tip to the far edge
+    # separated.msh: the mesh cut along the opened faces, which are its boundary 'opened' (label 31), both sides
+    # measured: h = 0.1 m: 44 faces, 41 vertices doubled, one body (faces parallel to the load stay closed);
+    # h = 0.07 m: 38 faces, 37 vertices doubled, two bodies of 1.065 and 0.925 m^2
+    rep = json.loads((root / "separated.json").read_text())
+    assert rep["opened_faces"] == recs[-1]["dg_open_faces"] and rep["opened_segments"] == 2 * rep["opened_faces"]
+    assert rep["opened_length"] == pytest.approx(recs[-1]["dg_open_length"], rel=1e-9)
+    assert sum(rep["body_areas"]) == pytest.approx(2.0 - 0.5 * 0.2 * 0.1, rel=1e-9)    # plate minus the notch
+    assert rep["bodies"] == (1 if h == 0.1 else 2)
+    m = meshio.read(root / "separated.msh", file_format="gmsh")
+    assert m.field_data["opened"].tolist() == [31, 1]
+    lines = np.concatenate([c.data[m.cell_data["gmsh:physical"][i] == 31] for i, c in enumerate(m.cells) if c.type == "line"])
+    assert len(lines) == rep["opened_segments"] and len(m.points) == len(points) + rep["duplicated_vertices"]
+    if h == 0.07:
+        # continued with CG on the separated mesh: a pressure on 'opened' pushes the two bodies apart
+        cont = scene_file(CONTINUE.format(mesh=root / "separated.msh"), "cont.toml")
+        croot = run(cont, out=tmp_path / "cont", png=False, progress=quiet)
+        u = read_array(croot / "fem" / "inc-0001" / "u.node.txt").reshape(-1, 2)
+        twins = {}
+        for v in np.unique(lines):
+            twins.setdefault(tuple(np.round(m.points[v, :2], 12)), []).append(v)
+        split = [vs for vs in twins.values() if len(vs) == 2]
+        assert len(split) >= 10
+        jump = np.array([np.linalg.norm(u[i] - u[j]) for i, j in split])
+        # the two copies of a vertex on the cut move apart (a CG field on the uncut mesh has one value there)
+        assert np.median(jump) > 0.1 * np.abs(u).max(), (jump, np.abs(u).max())
 
 
 def test_a_killed_separating_run_resumes_to_the_same_result(tmp_path):
