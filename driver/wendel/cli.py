@@ -73,8 +73,8 @@ def main(argv: list[str] | None = None) -> int:
     p = sub.add_parser("bench", help="benchmarks; results into results/bench/",
                        formatter_class=argparse.RawTextHelpFormatter)     # names are not wrapped at hyphens
     p.add_argument("names", nargs="*", help="benchmarks to run (default: all of these):\n"
-                   "  axisymmetric, cylinder, dg, drilling, elasticity, friction, obstacle, petsc, remesh, step42,\n"
-                   "  sweep, thermal, ul,\n"
+                   "  axisymmetric, cylinder, dg, dg-3d, drilling, elasticity, friction, obstacle, petsc, remesh,\n"
+                   "  step42, sweep, thermal, ul,\n"
                    "  necking (Simo's necking bar on 3 meshes),\n"
                    "  oxley, oxley-domain, oxley-kienzle (the analytic orthogonal cut);\n"
                    "only when named: step42-dealii, overhead, gmsh3d,\n"

@@ -12,9 +12,10 @@ jump. The sufficient stability bound of both penalties (dg.idp's header) is ``2 
 
 from __future__ import annotations
 
-from typing import Literal
+import math
+from typing import Literal, Optional
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, field_validator
 
 from . import Block, register
 
@@ -30,14 +31,30 @@ class Discretization(BaseModel):
     model_config = ConfigDict(extra="forbid", validate_assignment=True)
 
     kind: Literal["cg", "dg"] = Field("cg", description="cg: continuous Lagrange (elasticity.order); dg: "
-                                      "interior penalty with Nitsche boundaries (2D elastic scenes)")
+                                      "interior penalty with Nitsche boundaries (2D; 3D linear elastic)")
     order: int = Field(1, ge=1, le=2, description="polynomial degree of the DG displacement (P1dc, P2dc) [1]")
     gamma_mu: float = Field(20.0, gt=0, le=1e6, description="penalty on the jump, times 2 mu |F|/|K| [1]; "
-                            "sufficient: 6 (P1), 18 (P2) in 2D")
+                            "sufficient: 6 (P1), 18 (P2) in 2D, 8 and 21.3 in 3D")
     gamma_lambda: float = Field(20.0, gt=0, le=1e6, description="penalty on the normal jump, times lambda "
                                 "|F|/|K| [1]; same bound")
     separation_stress: float = Field(0.0, ge=0, le=1e15, description="dg: an interior face whose normal stress "
                                      "(mean of its two elements) exceeds this opens for good [Pa]; 0 = never")
+    region: Optional[list[list[float]]] = Field(None, description="dg in 2D: only the cells whose centre lies in "
+                                                "this box [[x0, y0], [x1, y1]] are DG, the others CG, coupled by "
+                                                "Nitsche terms (elastic) [m]")
+
+    @field_validator("region")
+    @classmethod
+    def _region(cls, v):
+        if v is None:
+            return v
+        if len(v) != 2 or any(len(c) != 2 for c in v):
+            raise ValueError("region must be [[x0, y0], [x1, y1]] (m)")
+        if any(not math.isfinite(c) or abs(c) > 1e30 for p in v for c in p):
+            raise ValueError(f"region: coordinates must be finite numbers below 1e30 in size, got {v}")
+        if not (v[0][0] < v[1][0] and v[0][1] < v[1][1]):
+            raise ValueError(f"region: the corners must increase, [[x0, y0], [x1, y1]] with x0 < x1, y0 < y1; got {v}")
+        return v
 
 
 def penalty_warnings(block: Discretization, dimension: int) -> list[str]:
@@ -55,7 +72,11 @@ def check(block: Discretization, scene) -> None:
     if block.kind != "dg":
         if block.separation_stress > 0:
             raise ValueError("discretization.separation_stress needs discretization.kind = 'dg'")
+        if block.region is not None:
+            raise ValueError("discretization.region needs discretization.kind = 'dg'")
         return
+    if block.region is not None and (getattr(scene, "plasticity", None) is not None or block.separation_stress > 0):
+        raise ValueError("discretization.region (CG and DG in one mesh) is elastic only, without separation_stress")
     others = [n for n in scene.blocks if n not in ("discretization", "plasticity")]
     if others:
         raise ValueError(f"discretization.kind = 'dg' is implemented for elastic and plastic scenes only; "
@@ -65,9 +86,9 @@ def check(block: Discretization, scene) -> None:
                          "stress is the element's one-point stress)")
     g = scene.geometry
     if (g.builder == "box" or g.dimension == 3) and (getattr(scene, "plasticity", None) is not None
-                                                    or block.separation_stress > 0):
+                                                    or block.separation_stress > 0 or block.region is not None):
         raise ValueError("discretization.kind = 'dg' in 3D is linear elastic only (no [plasticity], no "
-                         "separation_stress): FreeFEM 4.9 assembles 3D face terms as matrices only (dg3d.idp)")
+                         "separation_stress, no region): FreeFEM 4.9 assembles 3D face terms as matrices only (dg3d.idp)")
     if scene.elasticity.plane == "axisymmetric" or scene.elasticity.order != 1:
         raise ValueError("discretization.kind = 'dg' needs elasticity.plane = 'strain' or 'stress' and "
                          "elasticity.order = 1 (the DG degree is discretization.order)")
@@ -85,7 +106,10 @@ def options(block: Discretization, scene, files) -> list[str]:
     if block.kind != "dg":
         return []
     return ["-dg_gamma_mu", repr(block.gamma_mu), "-dg_gamma_lambda", repr(block.gamma_lambda),
-            "-dg_order", str(block.order), "-dg_sep_stress", repr(block.separation_stress)]
+            "-dg_order", str(block.order), "-dg_sep_stress", repr(block.separation_stress)] + \
+        ([] if block.region is None else ["-dg_region_x0", repr(block.region[0][0]), "-dg_region_y0",
+                                          repr(block.region[0][1]), "-dg_region_x1", repr(block.region[1][0]),
+                                          "-dg_region_y1", repr(block.region[1][1])])
 
 
 def macros(scene) -> list[str]:
