@@ -20,7 +20,7 @@ from ..errors import DiskFull, RunFolderError
 from ..meshes import build as build_mesh
 from ..remesh import batch as remesh_batch
 from ..remesh.step import finish_report, judge, maybe_remesh
-from ..results import pictures, summary, vtu
+from ..results import pictures, separation, summary, vtu
 from ..scene import load
 from ..scene.reading import check_size
 from ..scene.schema import Scene
@@ -121,7 +121,7 @@ def _solve_and_report(scene: Scene, files: RunFiles, state: State, dimension: in
                 and not after_reequilibration:
             maybe_remesh(scene, files, state, dimension, progress)    # a run resumed before the decision
         solve(scene, files, state, dimension, progress)
-        _separated(scene, files, state, progress)
+        separation.after_run(scene, files, state, progress)
     finally:
         with contextlib.suppress(OSError):       # a full disk must not hide why the run stopped
             summary.write_summary(files.root, scene, state, dimension)
@@ -138,20 +138,6 @@ def _solve_and_report(scene: Scene, files: RunFiles, state: State, dimension: in
                 painter.paint(Path(tmp) / "last.vtu", files.root / "deformed.png", f"load factor {lf:g}",
                               scene.output.warp, deformed=scene.kinematics.updated_lagrangian)
         summary.write_summary(files.root, scene, state, dimension, picture=time.perf_counter() - t0)
-
-
-def _separated(scene: Scene, files: RunFiles, state: State, progress) -> None:
-    """A separating DG run: separated.msh, the mesh cut along the faces opened by the last increment."""
-    dg = getattr(scene, "discretization", None)
-    if dg is None or dg.separation_stress <= 0 or not state.accepted:
-        return
-    from ..results.separation import write_separated
-
-    inc = state.last[0]
-    rep = write_separated(files.root / state.segment(inc)["mesh"], files.fem / f"inc-{inc:04d}",
-                          files.root / "separated.msh")
-    progress(f"  separated.msh: {rep['opened_faces']} opened faces (boundary 'opened', {rep['opened_length']:.3g} m), "
-             f"{rep['bodies']} bodies")
 
 
 def _write_increment_vtu(files: RunFiles, state: State, dimension: int, inc: int, path: Path,

@@ -172,3 +172,15 @@ def write_separated(mesh_path: Path, inc_dir: Path, out: Path) -> dict:
               "duplicated_vertices": len(points) - len(m.points)}
     out.with_suffix(".json").write_text(json.dumps(report, indent=1))
     return report
+
+
+def after_run(scene, files, state, progress) -> None:
+    """A separating DG run: separated.msh, the mesh cut along the faces opened by the last increment."""
+    dg = getattr(scene, "discretization", None)
+    if dg is None or dg.separation_stress <= 0 or not state.accepted:
+        return
+    inc = state.last[0]
+    rep = write_separated(files.root / state.segment(inc)["mesh"], files.fem / f"inc-{inc:04d}",
+                          files.root / "separated.msh")
+    progress(f"  separated.msh: {rep['opened_faces']} opened faces (boundary '{OPENED}', {rep['opened_length']:.3g} m), "
+             f"{rep['bodies']} bodies")
