@@ -85,10 +85,9 @@ def check(block: Discretization, scene) -> None:
         raise ValueError("discretization.kind = 'dg' with [plasticity] needs discretization.order = 1 (the face "
                          "stress is the element's one-point stress)")
     g = scene.geometry
-    if (g.builder == "box" or g.dimension == 3) and (getattr(scene, "plasticity", None) is not None
-                                                    or block.separation_stress > 0 or block.region is not None):
-        raise ValueError("discretization.kind = 'dg' in 3D is linear elastic only (no [plasticity], no "
-                         "separation_stress, no region): FreeFEM 4.9 assembles 3D face terms as matrices only (dg3d.idp)")
+    if (g.builder == "box" or g.dimension == 3) and (block.separation_stress > 0 or block.region is not None):
+        raise ValueError("discretization.kind = 'dg' in 3D has no separation_stress and no region: FreeFEM 4.9 "
+                         "assembles 3D face terms as matrices only (dg3d.idp)")
     if scene.elasticity.plane == "axisymmetric" or scene.elasticity.order != 1:
         raise ValueError("discretization.kind = 'dg' needs elasticity.plane = 'strain' or 'stress' and "
                          "elasticity.order = 1 (the DG degree is discretization.order)")
