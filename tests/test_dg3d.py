@@ -42,6 +42,15 @@ order = 1                # P1dc
 """
 
 
+def test_a_3d_dg_scene_compiles_the_3d_dg_module(tmp_path):
+    from test_entry import MODULES, compiled
+
+    found, switches, record = compiled(tmp_path / "dg", "cantilever-dg-3d.toml")
+    assert found & set(MODULES) == {"dg", "dg3d"}, found
+    assert switches == ["-Ddimension=3", "-DPk=P1dc", "-DWITHDG=1"]
+    assert record["dg_gamma_min"] == 8 and record["dg_face_assembly_s"] > 0
+
+
 def test_dg_3d_reproduces_a_uniform_strain_with_per_component_nitsche_conditions(tmp_path, scene_file, quiet):
     # eps_xx = 1e-3 with free lateral faces: u = (1e-3 x, -nu 1e-3 y, -nu 1e-3 z); exact for P1, so the interior
     # face fluxes {sigma} n . [v] and the Nitsche terms of each constrained component must be consistent

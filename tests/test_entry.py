@@ -25,9 +25,10 @@ GUARDS = {"plasticity": "wendelPlasticityIdp", "contact": "wendelContactIdp", "t
           "thermal-fields": "wendelThermalFieldsIdp", "elasticity": "wendelElasticityIdp",
           "axisymmetric": "wendelAxisymmetricIdp", "axisymmetric-mechanics": "wendelAxisymmetricMechanicsIdp",
           "remeshstop": "wendelRemeshStopIdp", "kinematics": "wendelKinematicsIdp",
-          "friction": "wendelFrictionIdp", "tool": "wendelToolIdp", "petsc": "wendelPetscIdp", "dg": "wendelDgIdp"}
+          "friction": "wendelFrictionIdp", "tool": "wendelToolIdp", "petsc": "wendelPetscIdp", "dg": "wendelDgIdp",
+          "dg3d": "wendelDg3dIdp"}
 MODULES = ("plasticity", "contact", "thermal", "thermal-fields", "axisymmetric", "axisymmetric-mechanics", "remeshstop",
-           "kinematics", "friction", "tool", "dg")
+           "kinematics", "friction", "tool", "dg", "dg3d")
 
 
 def compiled(tmp_path, scene_name: str, solver: str | None = None) -> tuple[set[str], list[str], dict]:

@@ -41,7 +41,7 @@ def _cantilever(quick: bool, workdir: Path) -> list[dict]:
         assert load(scene_nu).material.nu == nu
         ref = timoshenko(nu)
         # DG P2 at h = 0.5 (72k DoFs, about a minute) only where CG locks
-        sizes = {"cg1": [1.0, 0.5, 0.25], "dg1": [1.0, 0.5], "dg2": [1.0, 0.5] if nu > 0.4 else [1.0]}
+        sizes = {"cg1": [1.0, 0.5, 0.25, 0.125], "dg1": [1.0, 0.5, 0.25], "dg2": [1.0, 0.5] if nu > 0.4 else [1.0]}
         for method, hs in sizes.items():
             for h in hs[:2] if quick else hs:
                 if quick and method == "dg2" and h < 1.0:

@@ -68,7 +68,8 @@ def penalty_warnings(block: Discretization, dimension: int) -> list[str]:
 
 
 def check(block: Discretization, scene) -> None:
-    """DG joins plasticity (P1) only: 2D plane scenes, direct solver, no remesh, no prescribed motion."""
+    """DG joins plasticity (P1) only; plane 2D or 3D (3D: no separation, no region); direct solver, no remesh,
+    no prescribed motion."""
     if block.kind != "dg":
         if block.separation_stress > 0:
             raise ValueError("discretization.separation_stress needs discretization.kind = 'dg'")
