@@ -149,13 +149,16 @@ def test_homogeneous_tension_and_compression_to_large_strain(scene_file, tmp_pat
     assert abs(loads[-1]) in (1.0, 0.5)
 
 
-@pytest.mark.parametrize("top", [1.0, -0.5])     # 100 % nominal tension; compression to 50 % height
-def test_uniaxial_tension_and_compression_3d_on_the_closed_form_curve(scene_file, tmp_path, quiet, top):
+@pytest.mark.parametrize("top, volumetric", [(1.0, "cell"), (-0.5, "cell"), (1.0, "fbar")])
+def test_uniaxial_tension_and_compression_3d_on_the_closed_form_curve(scene_file, tmp_path, quiet, top, volumetric):
     """3D cube, frictionless ends, linear hardening: Cauchy stress against log strain on
     sigma = sigma0 + E H / (E + H) (|eps| - sigma0 / E) (1e-10), lateral stress 0, the end force equals
-    sigma_y(eps) times the current section (1e-10)."""
+    sigma_y(eps) times the current section (1e-10). 100 % nominal tension, compression to 50 % height, and
+    the tension with F-bar (kinematics.volumetric = "fbar": homogeneous, so the same closed form)."""
     E, H, s0 = 70e9, 1e9, 250e6
     text = (WORKFLOWS / "ul-tension-3d.toml").read_text().replace("uz = 1.0 ", f"uz = {top!r} ")
+    text = text.replace('kind = "updated-lagrangian"', f'kind = "updated-lagrangian"\nvolumetric = "{volumetric}"')
+    assert f'volumetric = "{volumetric}"' in text
     root = run(scene_file(text, "t3.toml"), smoke=True, out=tmp_path / "t3", progress=quiet, png=False)
     incs = increments(root)
     assert len(incs) == 10

@@ -54,6 +54,8 @@ def macros(scene: Scene, dimension: int) -> list[str]:
     switches += axisymmetric.macros(scene, dimension)
     if scene.kinematics.updated_lagrangian:
         switches.append("-DUPDATEDLAGRANGIAN=1")     # edp/lib/kinematics.idp
+        if scene.kinematics.volumetric == "fbar" and dimension == 2 and scene.elasticity.plane != "axisymmetric":
+            raise ValueError("kinematics.volumetric = \"fbar\" is for (r, z) and 3D scenes, not 2D plane strain")
     if getattr(scene, "contact", None) is not None and in_current_configuration(scene.contact, scene):
         switches.append("-DWITHFRICTION=1")      # friction, tool, path or force control: edp/lib/friction.idp
     if scene.numerics.solver == "petsc":
@@ -101,7 +103,7 @@ def kinematics_options(scene: Scene) -> list[str]:
     if not k.updated_lagrangian:
         return []
     e = k.initial_strain
-    return ["-ul_min_jacobian", repr(k.min_area_ratio),
+    return ["-ul_min_jacobian", repr(k.min_area_ratio), "-ul_volumetric", str(int(k.volumetric == "fbar")),
             "-ul_eps_xx", repr(e[0]), "-ul_eps_yy", repr(e[1]), "-ul_eps_xy", repr(e[2])]
 
 
