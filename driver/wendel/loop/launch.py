@@ -54,8 +54,6 @@ def macros(scene: Scene, dimension: int) -> list[str]:
     switches += axisymmetric.macros(scene, dimension)
     if scene.kinematics.updated_lagrangian:
         switches.append("-DUPDATEDLAGRANGIAN=1")     # edp/lib/kinematics.idp
-        if scene.kinematics.volumetric == "fbar" and dimension == 2 and scene.elasticity.plane != "axisymmetric":
-            raise ValueError("kinematics.volumetric = \"fbar\" is for (r, z) and 3D scenes, not 2D plane strain")
     if getattr(scene, "contact", None) is not None and in_current_configuration(scene.contact, scene):
         switches.append("-DWITHFRICTION=1")      # friction, tool, path or force control: edp/lib/friction.idp
     if scene.numerics.solver == "petsc":
