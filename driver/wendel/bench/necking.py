@@ -96,9 +96,10 @@ def necking_bench(quick: bool, workdir: Path) -> list[dict]:
 
 
 REMESH_AT = [35, 45, 52, 57, 61, 64, 67]   # increments after which the remeshed runs remesh (and on quality)
-# (h, h_neck, remesh (h, h_min) or None), m, of the scene before scaling
-FINE_CASES = [(2.0e-3, 0.8e-3, None), (0.35e-3, 0.14e-3, None), (2.0e-3, 0.8e-3, (2.0e-3, 0.4e-3)),
-              (1.0e-3, 0.4e-3, (1.0e-3, 0.2e-3))]
+# (h, h_neck, remesh (h, h_min) or None, ends held radially), m, of the scene before scaling
+FINE_CASES = [(2.0e-3, 0.8e-3, None, False), (0.35e-3, 0.14e-3, None, False),
+              (2.0e-3, 0.8e-3, (2.0e-3, 0.4e-3), False), (1.0e-3, 0.4e-3, (1.0e-3, 0.2e-3), False),
+              (1.0e-3, 0.4e-3, None, True)]
 
 
 def scaled(scene, s: float):
@@ -125,7 +126,8 @@ def necking_fine_bench(quick: bool, workdir: Path) -> list[dict]:
     """The F-bar necking bar beyond ``necking``'s meshes, on the bar scaled by 1000 in length (see
     :func:`scaled`): a fixed mesh with h_neck = 0.14 mm, and remeshed runs (after the increments of
     ``REMESH_AT`` and on quality; new meshes of the current configuration graded by p from h to h_min) from
-    the 2 / 0.8 and 1 / 0.4 mm starts (--quick: the first two rows). About 4 minutes."""
+    the 2 / 0.8 and 1 / 0.4 mm starts, and the 1 / 0.4 mm mesh with its moving end held radially (--quick: the
+    first two rows). About 4 minutes."""
     from ..scene.schema import Remesh
 
     S = 1000.0
@@ -134,16 +136,19 @@ def necking_fine_bench(quick: bool, workdir: Path) -> list[dict]:
     if quick:
         cases = cases[:2]
     rows = []
-    for h, hn, rm in cases:
+    for h, hn, rm, clamped in cases:
         scene = load(path)
         scene.geometry.h = h
         scene.geometry.params["refine"]["h"] = hn
         if rm is not None:
             scene.remesh = Remesh(at=REMESH_AT, h=rm[0], h_min=rm[1], max_remeshes=40)
+        if clamped:             # u_r = 0 on the moving end (a rigid grip) instead of a frictionless one
+            scene.boundary["top"].ux = 0.0
         scene.output.png = False
         scene.output.vtu = False
         scaled(scene, S)
-        name = f"h{h * 1e3:g}mm-hn{hn * 1e3:g}mm" + (f"-remesh{rm[1] * 1e3:g}mm" if rm else "")
+        name = f"h{h * 1e3:g}mm-hn{hn * 1e3:g}mm" + (f"-remesh{rm[1] * 1e3:g}mm" if rm else "") + (
+            "-clamped" if clamped else "")
         out = workdir / name
         s = run_fresh(scene, path, out)
         c = [{**r, "elongation": r["elongation"] / S, "force": r["force"] / S ** 2, "neck_radius": r["neck_radius"] / S,
@@ -151,6 +156,7 @@ def necking_fine_bench(quick: bool, workdir: Path) -> list[dict]:
         peak = max(c, key=lambda r: r["force"])
         rem = s.get("remeshes") or []
         rows.append({"h_mm": h * 1e3, "h_neck_mm": hn * 1e3, "remesh_h_min_mm": rm[1] * 1e3 if rm else 0.0,
+                     "ends": "clamped" if clamped else "frictionless",
                      "remeshes": len(rem), "dofs_last_mesh": s["dofs"],
                      "max_residual_after_transfer": max((r["residual_after_transfer"] for r in rem), default=0.0),
                      "increments": s["increments"], "newton_iterations": s["newton_iterations"],
