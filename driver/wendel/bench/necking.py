@@ -89,7 +89,7 @@ def necking_bench(quick: bool, workdir: Path) -> list[dict]:
                          "peak_force_kN": peak["force"] / 1e3, "peak_at_mm": peak["elongation"] * 1e3,
                          "considere_neck_kN": f_neck / 1e3, "considere_full_kN": f_full / 1e3,
                          **{f"r_neck/R0_{e:g}mm": at(c, "neck_radius", e * 1e-3) / R0 for e in (7, 10, 12, 14)},
-                         **{f"force_{e:g}mm_kN": at(c, "force", e * 1e-3) / 1e3 for e in (10, 12, 14)},
+                         **{f"force_{e:g}mm_kN": at(c, "force", e * 1e-3) / 1e3 for e in (7, 10, 12, 14)},
                          "r_end/R0_14mm": at(c, "end_radius", 14e-3) / R0})
             (workdir / f"curve-{volumetric}-h{h * 1e3:g}mm.json").write_text(json.dumps(c))
     return rows
@@ -162,6 +162,6 @@ def necking_fine_bench(quick: bool, workdir: Path) -> list[dict]:
                      "increments": s["increments"], "newton_iterations": s["newton_iterations"],
                      "wall_s": round(s["wall_time"], 2), "peak_force_kN": peak["force"] / 1e3,
                      **{f"r_neck/R0_{e:g}mm": at(c, "neck_radius", e * 1e-3) / R0 for e in (7, 10, 12, 14)},
-                     **{f"force_{e:g}mm_kN": at(c, "force", e * 1e-3) / 1e3 for e in (10, 12, 14)}})
+                     **{f"force_{e:g}mm_kN": at(c, "force", e * 1e-3) / 1e3 for e in (7, 10, 12, 14)}})
         (workdir / f"curve-{name}.json").write_text(json.dumps(c))
     return rows
