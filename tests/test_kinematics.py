@@ -119,6 +119,7 @@ def test_stress_free_rotation_stays_stress_free_and_small_strain_does_not(scene_
     ("ul-tension.toml", 0, "reaction_x_2", 1, False),      # 100 % nominal tension, force on the right end
     ("ul-compression.toml", 1, "reaction_y_4", 0, False),  # 50 % height, force on the top platen
     ("ul-tension.toml", 0, "reaction_x_2", 1, True),       # remeshed after increment 5 (finer mesh)
+    ("ul-compression.toml", 1, "reaction_y_4", 0, "fbar"),  # F-bar (kinematics.volumetric): homogeneous, the same
 ])
 def test_homogeneous_tension_and_compression_to_large_strain(scene_file, tmp_path, quiet, scene, axis, reaction,
                                                             lateral, remesh):
@@ -126,6 +127,10 @@ def test_homogeneous_tension_and_compression_to_large_strain(scene_file, tmp_pat
     sigma_y(p) = sigma0 + H p (1e-10); end force = stress x current section (1e-8). With a remesh the new
     mesh is made of the current configuration and the state carries over."""
     text = (WORKFLOWS / scene).read_text()
+    if remesh == "fbar":
+        text = text.replace('kind = "updated-lagrangian"', 'kind = "updated-lagrangian"\nvolumetric = "fbar"')
+        assert 'volumetric = "fbar"' in text
+        remesh = False
     if remesh:      # at the smoke size (10 increments; one launch per increment when remeshing)
         text = text.replace("[output]", "[remesh]\nat = [5]\nh = 0.05\n\n[output]")
     root = run(scene_file(text, "s.toml"), smoke=remesh, out=tmp_path / "r", progress=quiet, png=False)
@@ -149,13 +154,16 @@ def test_homogeneous_tension_and_compression_to_large_strain(scene_file, tmp_pat
     assert abs(loads[-1]) in (1.0, 0.5)
 
 
-@pytest.mark.parametrize("top", [1.0, -0.5])     # 100 % nominal tension; compression to 50 % height
-def test_uniaxial_tension_and_compression_3d_on_the_closed_form_curve(scene_file, tmp_path, quiet, top):
+@pytest.mark.parametrize("top, volumetric", [(1.0, "cell"), (-0.5, "cell"), (1.0, "fbar")])
+def test_uniaxial_tension_and_compression_3d_on_the_closed_form_curve(scene_file, tmp_path, quiet, top, volumetric):
     """3D cube, frictionless ends, linear hardening: Cauchy stress against log strain on
     sigma = sigma0 + E H / (E + H) (|eps| - sigma0 / E) (1e-10), lateral stress 0, the end force equals
-    sigma_y(eps) times the current section (1e-10)."""
+    sigma_y(eps) times the current section (1e-10). 100 % nominal tension, compression to 50 % height, and
+    the tension with F-bar (kinematics.volumetric = "fbar": homogeneous, so the same closed form)."""
     E, H, s0 = 70e9, 1e9, 250e6
     text = (WORKFLOWS / "ul-tension-3d.toml").read_text().replace("uz = 1.0 ", f"uz = {top!r} ")
+    text = text.replace('kind = "updated-lagrangian"', f'kind = "updated-lagrangian"\nvolumetric = "{volumetric}"')
+    assert f'volumetric = "{volumetric}"' in text
     root = run(scene_file(text, "t3.toml"), smoke=True, out=tmp_path / "t3", progress=quiet, png=False)
     incs = increments(root)
     assert len(incs) == 10

@@ -62,7 +62,8 @@ def at(rows: list[dict], key: str, elongation: float) -> float:
 @register("necking")
 def necking_bench(quick: bool, workdir: Path) -> list[dict]:
     """workflows/ul-necking-bar.toml at three mesh sizes (h outside the neck zone, h_neck in it; --quick: the
-    two coarser); 70 increments to 14 mm."""
+    two coarser), with F-bar (the scene's kinematics.volumetric) and with the P1 cell's own volume change;
+    70 increments to 14 mm."""
     levels = [(2.0e-3, 0.8e-3), (1.0e-3, 0.4e-3), (0.5e-3, 0.2e-3)]
     if quick:
         levels = levels[:2]
@@ -70,22 +71,97 @@ def necking_bench(quick: bool, workdir: Path) -> list[dict]:
     _, f_full = considere(R0)
     eps_c, f_neck = considere(0.982 * R0)
     rows = []
-    for h, hn in levels:
+    for volumetric in ("fbar", "cell"):
+        for h, hn in levels:
+            scene = load(path)
+            scene.geometry.h = h
+            scene.geometry.params["refine"]["h"] = hn
+            scene.kinematics.volumetric = volumetric
+            scene.output.png = False
+            scene.output.vtu = False
+            out = workdir / f"{volumetric}-h{h * 1e3:g}mm"
+            s = run_fresh(scene, path, out)
+            c = curve(out)
+            peak = max(c, key=lambda r: r["force"])
+            rows.append({"volumetric": volumetric, "h_mm": h * 1e3, "h_neck_mm": hn * 1e3, "dofs": s["dofs"],
+                         "increments": s["increments"], "newton_iterations": s["newton_iterations"],
+                         "wall_s": round(s["wall_time"], 2),
+                         "peak_force_kN": peak["force"] / 1e3, "peak_at_mm": peak["elongation"] * 1e3,
+                         "considere_neck_kN": f_neck / 1e3, "considere_full_kN": f_full / 1e3,
+                         **{f"r_neck/R0_{e:g}mm": at(c, "neck_radius", e * 1e-3) / R0 for e in (7, 10, 12, 14)},
+                         **{f"force_{e:g}mm_kN": at(c, "force", e * 1e-3) / 1e3 for e in (7, 10, 12, 14)},
+                         "r_end/R0_14mm": at(c, "end_radius", 14e-3) / R0})
+            (workdir / f"curve-{volumetric}-h{h * 1e3:g}mm.json").write_text(json.dumps(c))
+    return rows
+
+
+REMESH_AT = [35, 45, 52, 57, 61, 64, 67]   # increments after which the remeshed runs remesh (and on quality)
+# (h, h_neck, remesh (h, h_min) or None, ends held radially), m, of the scene before scaling
+FINE_CASES = [(2.0e-3, 0.8e-3, None, False), (0.35e-3, 0.14e-3, None, False),
+              (2.0e-3, 0.8e-3, (2.0e-3, 0.4e-3), False), (1.0e-3, 0.4e-3, (1.0e-3, 0.2e-3), False),
+              (1.0e-3, 0.4e-3, None, True)]
+
+
+def scaled(scene, s: float):
+    """The scene with every length times ``s``: a rate-independent bar without body force deforms alike, so
+    r / R0 and the elongation / s are unchanged and forces scale by s^2. FreeFEM's mesh reader refuses
+    triangles under 1e-8 in area (absolute), which in metres stops h_neck below ~0.16 mm."""
+    g = scene.geometry
+    g.h *= s
+    prm = g.model_extra
+    prm["radius"] *= s
+    prm["length"] *= s
+    ref = prm["refine"]
+    prm["refine"] = {"box": [[c * s for c in p] for p in ref["box"]], "thickness": ref["thickness"] * s,
+                     "h": ref["h"] * s}
+    scene.boundary["top"].uy *= s
+    if scene.remesh is not None:
+        scene.remesh.h *= s
+        scene.remesh.h_min *= s
+    return scene
+
+
+@register("necking-fine")
+def necking_fine_bench(quick: bool, workdir: Path) -> list[dict]:
+    """The F-bar necking bar beyond ``necking``'s meshes, on the bar scaled by 1000 in length (see
+    :func:`scaled`): a fixed mesh with h_neck = 0.14 mm, and remeshed runs (after the increments of
+    ``REMESH_AT`` and on quality; new meshes of the current configuration graded by p from h to h_min) from
+    the 2 / 0.8 and 1 / 0.4 mm starts, and the 1 / 0.4 mm mesh with its moving end held radially (--quick: the
+    first two rows). About 4 minutes."""
+    from ..scene.schema import Remesh
+
+    S = 1000.0
+    path = WORKFLOWS / "ul-necking-bar.toml"
+    cases = FINE_CASES
+    if quick:
+        cases = cases[:2]
+    rows = []
+    for h, hn, rm, clamped in cases:
         scene = load(path)
         scene.geometry.h = h
         scene.geometry.params["refine"]["h"] = hn
+        if rm is not None:
+            scene.remesh = Remesh(at=REMESH_AT, h=rm[0], h_min=rm[1], max_remeshes=40)
+        if clamped:             # u_r = 0 on the moving end (a rigid grip) instead of a frictionless one
+            scene.boundary["top"].ux = 0.0
         scene.output.png = False
         scene.output.vtu = False
-        out = workdir / f"h{h * 1e3:g}mm"
+        scaled(scene, S)
+        name = f"h{h * 1e3:g}mm-hn{hn * 1e3:g}mm" + (f"-remesh{rm[1] * 1e3:g}mm" if rm else "") + (
+            "-clamped" if clamped else "")
+        out = workdir / name
         s = run_fresh(scene, path, out)
-        c = curve(out)
+        c = [{**r, "elongation": r["elongation"] / S, "force": r["force"] / S ** 2, "neck_radius": r["neck_radius"] / S,
+              "end_radius": r["end_radius"] / S} for r in curve(out)]
         peak = max(c, key=lambda r: r["force"])
-        rows.append({"h_mm": h * 1e3, "h_neck_mm": hn * 1e3, "dofs": s["dofs"], "increments": s["increments"],
-                     "newton_iterations": s["newton_iterations"], "wall_s": round(s["wall_time"], 2),
-                     "peak_force_kN": peak["force"] / 1e3, "peak_at_mm": peak["elongation"] * 1e3,
-                     "considere_neck_kN": f_neck / 1e3, "considere_full_kN": f_full / 1e3,
-                     **{f"r_neck/R0_{e:g}mm": at(c, "neck_radius", e * 1e-3) / R0 for e in (7, 10, 14)},
-                     "force_14mm_kN": at(c, "force", 14e-3) / 1e3,
-                     "r_end/R0_14mm": at(c, "end_radius", 14e-3) / R0})
-        (workdir / f"curve-h{h * 1e3:g}mm.json").write_text(json.dumps(c))
+        rem = s.get("remeshes") or []
+        rows.append({"h_mm": h * 1e3, "h_neck_mm": hn * 1e3, "remesh_h_min_mm": rm[1] * 1e3 if rm else 0.0,
+                     "ends": "clamped" if clamped else "frictionless",
+                     "remeshes": len(rem), "dofs_last_mesh": s["dofs"],
+                     "max_residual_after_transfer": max((r["residual_after_transfer"] for r in rem), default=0.0),
+                     "increments": s["increments"], "newton_iterations": s["newton_iterations"],
+                     "wall_s": round(s["wall_time"], 2), "peak_force_kN": peak["force"] / 1e3,
+                     **{f"r_neck/R0_{e:g}mm": at(c, "neck_radius", e * 1e-3) / R0 for e in (7, 10, 12, 14)},
+                     **{f"force_{e:g}mm_kN": at(c, "force", e * 1e-3) / 1e3 for e in (7, 10, 12, 14)}})
+        (workdir / f"curve-{name}.json").write_text(json.dumps(c))
     return rows

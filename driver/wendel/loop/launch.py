@@ -101,7 +101,7 @@ def kinematics_options(scene: Scene) -> list[str]:
     if not k.updated_lagrangian:
         return []
     e = k.initial_strain
-    return ["-ul_min_jacobian", repr(k.min_area_ratio),
+    return ["-ul_min_jacobian", repr(k.min_area_ratio), "-ul_volumetric", str(int(k.volumetric == "fbar")),
             "-ul_eps_xx", repr(e[0]), "-ul_eps_yy", repr(e[1]), "-ul_eps_xy", repr(e[2])]
 
 

@@ -215,6 +215,11 @@ class Kinematics(Strict):
                                   "a cell's area below this ratio is refused as tangling (the step is cut) [1]")
     initial_strain: list[float] = Field([0.0, 0.0, 0.0], description="updated-Lagrangian: homogeneous initial "
                                         "strain [xx, yy, xy] (tensor components) of a prestressed body [1]")
+    volumetric: Literal["cell", "fbar"] = Field("cell", description="updated-Lagrangian: the "
+                                                "volume change of a P1 cell is its own (\"cell\"), or F-bar: the "
+                                                "increment's volume change averaged over the vertex patches "
+                                                "(\"fbar\"; against volumetric locking in plastic flow, "
+                                                "edp/lib/kinematics-fbar.idp)")
 
     @field_validator("initial_strain")
     @classmethod
@@ -350,6 +355,8 @@ class SceneBase(Strict):
                                  "or \"axisymmetric\"")
         elif self.kinematics.initial_strain != [0.0, 0.0, 0.0]:
             raise ValueError("kinematics.initial_strain needs kinematics.kind = \"updated-lagrangian\"")
+        elif self.kinematics.volumetric != "cell":
+            raise ValueError("kinematics.volumetric needs kinematics.kind = \"updated-lagrangian\"")
         if self.body_force.kind == "manufactured" and self.reference.analytic is None:
             raise ValueError("body_force.kind = \"manufactured\" needs reference.analytic")
         if self.problem == "mechanics":
