@@ -84,5 +84,5 @@ def test_fe_cut_forms_a_chip(tmp_path):
     st = summary["steady"]
     assert st["raw"] is None and st["cycles"] is None and st["length_m"] == pytest.approx(h)
     travel = [c["tool_travel_m"] for c in st["cycle_means"]]
-    assert len(travel) >= 4 and all(c["increments"] == 2 for c in st["cycle_means"]) and np.all(np.diff(travel) > 0)
+    assert len(travel) >= 4 and all(c["increments"] >= 2 for c in st["cycle_means"]) and np.all(np.diff(travel) > 0)
     assert (root / "chip.gif").stat().st_size > 10000

@@ -11,9 +11,10 @@ re-equilibration (by 25-30 % on the steel scene, measured) and recover over the 
 
 :func:`gif` writes ``chip.gif`` from the frames with Pillow.
 
->>> rows = [{"tool_travel_m": t * 1e-6, "Fc_N": 100.0, "Ft_N": 50.0, "chip_thickness_m": 2e-4} for t in (0, 5, 5, 10, 15, 20)]
->>> [round(r["tool_travel_m"] * 1e6) for r in cycle_means(rows)]
-[15]
+>>> rows = [{"tool_travel_m": t * 1e-6, "Fc_N": 100.0, "Ft_N": 50.0, "chip_thickness_m": 2e-4}
+...         for t in (0, 5, 5, 10, 15, 15, 20)]       # remeshed after 5 and 15 um: the 20 um cycle is cut short
+>>> [(round(r["tool_travel_m"] * 1e6, 1), r["increments"]) for r in cycle_means(rows)]
+[(2.5, 2), (12.5, 2)]
 """
 
 from __future__ import annotations
@@ -44,14 +45,13 @@ def _split(rows: list[dict]) -> list[list[dict]]:
 
 
 def cycle_means(rows: list[dict]) -> list[dict]:
-    """Per whole remesh cycle (as many increments as the longest): the mean travel and the means of the series
-    (finite values only)."""
+    """Per remesh cycle (the last one left out when it is shorter than the others): the mean travel and the
+    means of the series (finite values only)."""
     out = []
     cycles = _split(rows)
-    full = max((len(c) for c in cycles), default=0)
+    if len(cycles) > 1 and len(cycles[-1]) < np.median([len(c) for c in cycles[:-1]]):
+        cycles = cycles[:-1]       # the last cycle, cut short by the end of the run: biased low, left out
     for c in cycles:
-        if len(c) < full:          # the last cycle, cut short by the end of the run: biased low, left out
-            continue
         m = {"tool_travel_m": float(np.mean([r["tool_travel_m"] for r in c])), "increments": len(c)}
         for k in SERIES:
             v = np.array([r[k] for r in c], dtype=float)
