@@ -68,7 +68,7 @@ def _rows(out: Path) -> list[dict]:
 
 @register("cutting")
 def cutting_bench(quick: bool, workdir: Path) -> list[dict]:
-    """The scene as written (adiabatic); ``cutting-isothermal`` is the same cut without heating (each ~4 min)."""
+    """The scene as written (adiabatic); ``cutting-isothermal`` is the same cut without heating (each ~15 min)."""
     return [_case("adiabatic", WORKFLOWS / "cutting-aisi1045.toml", workdir, 20 if quick else None)]
 
 

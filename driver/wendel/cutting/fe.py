@@ -48,6 +48,7 @@ from .tool import tool_polygon
 MM = 1e3          # m -> mm
 MPA = 1e-6        # Pa -> MPa
 GAP = 0.02        # the tool starts this fraction of h in front of the step face
+RELAX_STEPS = 4   # the re-equilibration after a remesh releases the transferred out-of-balance in 4 stages
 
 
 def tool_at_start(cutting, x_step: float) -> dict:
@@ -106,7 +107,8 @@ def fe_scene(scene, travel: float = 1.0) -> Scene:
     at = [k * (every + 1) - 1 for k in range(1, (steps - 1) // every + 1)] if every else []
     # uniform size fine * h (graded on p down to half of it at the edge, the isothermal cut stopped at 40 um
     # instead of 92.5, measured: "mesh would invert" after the second remesh)
-    remesh = {"at": at, "indicator": "", "h": fine * g.h * MM, "max_remeshes": len(at) + 20}
+    remesh = {"at": at, "indicator": "", "h": fine * g.h * MM, "max_remeshes": len(at) + 20,
+              "relax_steps": RELAX_STEPS}
     boundary = {}
     for name, b in scene.boundary.items():
         d = b.model_dump(exclude_none=True)

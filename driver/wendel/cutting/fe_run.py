@@ -14,8 +14,9 @@ and record and writes ``cutting.csv`` and ``cutting.json`` in the run folder, an
   and between 1 and 2 h up the rake face from the tip (NaN while the chip is shorter than that);
 - ``tool_travel_m``, ``max_plastic_strain``, ``max_temperature_K`` (adiabatic cuts; NaN otherwise), ``elements``.
 
-``cutting.json`` adds the Oxley prediction of the same scene (``wendel oxley``) and the last increment's
-values beside it.
+``cutting.json`` adds the Oxley prediction of the same scene (``wendel oxley``), the last increment's
+values beside it and the steady state (:mod:`wendel.cutting.fe_steady`, a window of one h of travel);
+``chip.gif`` animates every second frame.
 """
 
 from __future__ import annotations
@@ -30,6 +31,7 @@ import numpy as np
 from . import chip
 from .fe import MM, fe_scene, forces, tool_at_start
 
+STEADY_LENGTH = 1.0    # the steady-state window: one uncut chip thickness of travel (fe_steady)
 COLUMNS = ["increment", "load_factor", "tool_travel_m", "Fc_N", "Ft_N", "chip_rise_m", "contact_length_m",
            "chip_thickness_m", "max_plastic_strain", "max_temperature_K", "elements"]
 
@@ -114,6 +116,11 @@ def report(root: Path, scene, frames: bool = True, travel: float = 1.0) -> list[
         w.writeheader()
         w.writerows(rows)
     summary = {"last": rows[-1] if rows else None, "width_m": c.width, "adiabatic": fe.thermal is not None}
+    if rows:
+        from .fe_steady import gif, steady
+        summary["steady"] = steady(rows, STEADY_LENGTH * h / MM)
+        if frames:
+            gif(root / "frames", root / "chip.gif", every=2)
     try:
         from .scene import predict, row
         summary["oxley"] = row(predict(scene))

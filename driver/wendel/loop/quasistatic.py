@@ -186,7 +186,8 @@ def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress)
         seg = state.segment(inc0)
         opts = options(scene, files, dimension, seg) + ["-loads", str(loads), "-inc0", str(inc0)]
         if state.reequilibrate:
-            opts += ["-restart", str(files.root / seg["state"])]
+            opts += ["-restart", str(files.root / seg["state"]), "-relax_steps",
+                     str(state.remeshes[-1].get("relax_steps", scene.remesh.relax_steps))]
         elif state.accepted:
             opts += ["-restart", str(files.fem / f"inc-{state.last[0]:04d}")]
         watcher = _Progress(files.fem, inc0, len(batch), batch, progress)

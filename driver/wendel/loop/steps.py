@@ -31,6 +31,9 @@ def grow_step(scene: Scene, state: State, files: RunFiles) -> None:
         state.step = min(state.step * loading.grow, loading.max_step or loading.nominal_step())
 
 
+RELAX_MAX = 64      # most stages of a re-equilibration (remesh.relax_steps doubled on failure)
+
+
 def cut_step(scene: Scene, files: RunFiles, state: State, failure: freefem.NewtonFailure, progress) -> None:
     """Halve the failed increment, or stop with a clear message when no cut is left."""
     rec = failure.record
@@ -44,6 +47,15 @@ def cut_step(scene: Scene, files: RunFiles, state: State, failure: freefem.Newto
         shutil.rmtree(failed)
     reason = rec.get("reason", "Newton did not converge")
     lf_prev, lf_fail = state.last[1], state.pending[0]
+    if state.reequilibrate and scene.remesh and lf_fail == lf_prev and state.remeshes:
+        # the re-equilibration after a remesh (no step to cut): release the out-of-balance in twice the stages
+        rep = state.remeshes[-1]
+        stages = 2 * rep.get("relax_steps", scene.remesh.relax_steps)
+        if stages <= RELAX_MAX:
+            rep["relax_steps"] = stages
+            state.cuts += 1
+            progress(f"  increment {inc}: {reason} in the re-equilibration; again in {stages} stages")
+            return
     state.cuts += 1
     mid = lf_prev + 0.5 * (lf_fail - lf_prev)
     smallest = scene.loading.nominal_step() / 2 ** scene.loading.max_cuts

@@ -251,6 +251,9 @@ class Remesh(Strict):
     indicator: str = Field("p", description="cell field that grades the size (e.g. p); empty: uniform size")
     max_remeshes: int = Field(20, ge=0, description="remeshes allowed in one run")
     at: list[int] = Field(default_factory=list, description="increments after which to remesh whatever the quality")
+    relax_steps: int = Field(1, ge=1, le=64, description="the re-equilibration after a remesh releases the "
+                             "transferred state's out-of-balance forces in this many stages, each converged by "
+                             "Newton (1: at once) [1]")
 
 
 class Reference(Strict):
