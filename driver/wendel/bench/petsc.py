@@ -26,7 +26,7 @@ DEFAULT_PC = "ml"
 
 
 def measure(scene_path: Path, out: Path, solver: str, pc: str = DEFAULT_PC, reuse: bool = True,
-            h: float | None = None, options: str = "", ranks: int = 1) -> dict:
+            h: float | None = None, options: str = "", ranks: int = 1, assembly: str = "freefem") -> dict:
     """Run one scene with one solver; return its row (wall times per Newton step by phase, CPU time of the
     FreeFEM processes for the whole run: on a shared machine the steadier figure)."""
     scene = load(scene_path)
@@ -37,6 +37,7 @@ def measure(scene_path: Path, out: Path, solver: str, pc: str = DEFAULT_PC, reus
     scene.numerics.petsc.pc = pc
     scene.numerics.petsc.reuse = reuse
     scene.numerics.petsc.options = options
+    scene.numerics.assembly = assembly
     scene.output.png = False
     scene.output.vtu = False
     shutil.rmtree(out, ignore_errors=True)
@@ -49,6 +50,7 @@ def measure(scene_path: Path, out: Path, solver: str, pc: str = DEFAULT_PC, reus
     newton = max(s["newton_iterations"], 1)
     return {"scene": scene_path.stem, "h": scene.geometry.h, "dofs": s["dofs"],
             "solver": solver if solver != "petsc" else f"petsc-{pc}" + ("" if reuse else "-noreuse"), "ranks": ranks,
+            "assembly": assembly,
             "newton_iterations": s["newton_iterations"],
             "krylov_per_step": last["linear_iterations"] / newton,
             "solve_s_per_step": ph["linear_solve"] / newton,
