@@ -8,7 +8,7 @@ seconds per Newton step of the linear solve (CSR conversion, preconditioner setu
 included), of the assembly (and of the tangent matrix alone) and of the constitutive update, the Krylov
 iterations per Newton step, the Newton iterations, the contact force (which must not depend on the solver) and
 the CPU time of the FreeFEM processes for the whole run (the steadier figure on a shared machine). One row
-alone: ``python -m wendel.bench.petsc SCENE H SOLVER [PC [REUSE [RANKS [OPTIONS]]]]``.
+alone: ``python -m wendel.bench.petsc SCENE H SOLVER [PC [REUSE [RANKS [OPTIONS [ASSEMBLY]]]]]``.
 """
 
 from __future__ import annotations
@@ -97,7 +97,7 @@ def petsc(quick: bool, workdir: Path) -> list[dict]:
 
 def main(argv: list[str] | None = None) -> None:
     """One row of the bench (each row is a run of up to a few minutes; the machine may be shared):
-    ``python -m wendel.bench.petsc SCENE H SOLVER [PC [REUSE [RANKS [OPTIONS]]]]``, e.g.
+    ``python -m wendel.bench.petsc SCENE H SOLVER [PC [REUSE [RANKS [OPTIONS [ASSEMBLY]]]]]``, e.g.
     ``python -m wendel.bench.petsc ball-indent 0.07 petsc ml``."""
     import sys
 
@@ -109,8 +109,10 @@ def main(argv: list[str] | None = None) -> None:
     reuse = a[4] != "0" if len(a) > 4 else True
     ranks = int(a[5]) if len(a) > 5 else 1
     options = a[6] if len(a) > 6 else ""
-    out = RESULTS / "bench" / "work" / "petsc-rows" / f"{scene}-h{h:g}-{solver}-{pc}-{int(reuse)}-np{ranks}"
-    r = measure(WORKFLOWS / f"{scene}.toml", out, solver, pc=pc, reuse=reuse, h=h, options=options, ranks=ranks)
+    assembly = a[7] if len(a) > 7 else "freefem"
+    out = RESULTS / "bench" / "work" / "petsc-rows" / f"{scene}-h{h:g}-{solver}-{pc}-{int(reuse)}-np{ranks}-{assembly}"
+    r = measure(WORKFLOWS / f"{scene}.toml", out, solver, pc=pc, reuse=reuse, h=h, options=options, ranks=ranks,
+                assembly=assembly)
     print(" ".join(f"{k}={v:.4g}" if isinstance(v, float) else f"{k}={v}" for k, v in r.items()))
 
 
