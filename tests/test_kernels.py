@@ -17,9 +17,11 @@ from wendel.scene import load
 from conftest import WORKFLOWS
 
 
-def ball(out, assembly: str) -> tuple[dict, np.ndarray]:
+def ball(out, assembly: str, solver: str = "cg", ranks: int = 1) -> tuple[dict, np.ndarray]:
     path = WORKFLOWS / "ball-indent.toml"
     scene = load(path, smoke=True)
+    scene.numerics.solver = solver
+    scene.numerics.ranks = ranks
     scene.numerics.assembly = assembly
     scene.output.png = False
     scene.output.vtu = False
@@ -28,8 +30,13 @@ def ball(out, assembly: str) -> tuple[dict, np.ndarray]:
     return json.loads((root / "summary.json").read_text()), np.array([float(x) for x in u])
 
 
-def test_compiled_kernels_reproduce_the_varf_assembly(tmp_path):
-    (f, uf), (c, uc) = ball(tmp_path / "freefem", "freefem"), ball(tmp_path / "compiled", "compiled")
+@pytest.fixture(scope="module")
+def ball_freefem(tmp_path_factory):
+    return ball(tmp_path_factory.mktemp("freefem"), "freefem")
+
+
+def test_compiled_kernels_reproduce_the_varf_assembly(tmp_path, ball_freefem):
+    (f, uf), (c, uc) = ball_freefem, ball(tmp_path / "compiled", "compiled")
     assert f["completed"] and c["completed"]
     lf, lc = f["last_increment"], c["last_increment"]
     assert lf["plastic_points"] > 0 and lf["contact_active_nodes"] > 0      # the kernels' whole tangent is used
@@ -42,6 +49,15 @@ def test_compiled_kernels_reproduce_the_varf_assembly(tmp_path):
     assert np.abs(uc - uf).max() <= 1e-10 * np.abs(uf).max()
     # the point of the kernels: the assembly of the Newton step is cheaper than FreeFEM's forms
     assert lc["time_tangent"] < lf["time_tangent"]
+
+
+def test_compiled_kernels_on_two_petsc_ranks(tmp_path, ball_freefem):
+    """Every rank runs the kernels on the whole mesh; PETSc solves on both: the same iterates."""
+    (f, uf), (c, uc) = ball_freefem, ball(tmp_path / "np2", "compiled", solver="petsc", ranks=2)
+    assert c["last_increment"]["ranks"] == 2
+    assert c["newton_iterations"] == f["newton_iterations"]
+    assert c["last_increment"]["contact_force"] == pytest.approx(f["last_increment"]["contact_force"], rel=1e-7)
+    assert np.abs(uc - uf).max() <= 1e-7 * np.abs(uf).max()
 
 
 @pytest.mark.parametrize("scene, extra, why", [
