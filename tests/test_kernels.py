@@ -71,6 +71,7 @@ def test_compiled_kernels_with_the_direct_solver(tmp_path):
 @pytest.mark.parametrize("scene, extra, why", [
     ("hertz-3d", "", "needs a [plasticity] table"),
     ("ul-tension-3d", "", "small-strain"),
+    ("cylinder", "", "a 3D body"),
 ])
 def test_compiled_assembly_refused_where_it_does_not_apply(tmp_path, scene, extra, why):
     text = (WORKFLOWS / f"{scene}.toml").read_text()

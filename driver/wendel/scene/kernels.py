@@ -3,7 +3,7 @@
 ``assembly = "compiled"`` (``-DWITHKERNELS=1``, ``edp/lib/kernels.idp``, plugin ``edp/plugins/wendel_kernels.cpp``)
 computes the quadrature-point strain, the internal forces and the consistent J2 tangent of 3D P1 small-strain
 plasticity in C++; the Newton algorithm, return mapping, contact and solver stay in the .edp scripts. Other
-combinations are refused here (the 3D condition at launch, where the dimension is known).
+combinations are refused here naming the key (and once more at launch, where the mesh's dimension is known).
 """
 
 from __future__ import annotations
@@ -26,10 +26,15 @@ def check(scene) -> None:
     disc = getattr(scene, "discretization", None)
     if disc is not None and getattr(disc, "kind", "cg") != "cg":
         why.append("continuous elements")
+    g = scene.geometry
+    if not (g.builder == "box" or (g.builder is None and g.dimension == 3)):
+        why.append("a 3D body (builder \"box\" or a 3D mesh file)")
+    if getattr(scene, "drilling", None) is not None:
+        why.append("no [drilling] table (not verified)")
     if scene.elasticity.order != 1:
         why.append("elasticity.order = 1")
     if scene.elasticity.plane == "axisymmetric":
-        why.append("a 3D body")
+        why.append("no (r, z) model")
     contact = getattr(scene, "contact", None)
     if contact is not None:
         from .blocks.contact import in_current_configuration
