@@ -12,7 +12,8 @@ APT_TEST_PACKAGES := slurmctld slurmd slurm-client slurmdbd munge mariadb-server
 SCENE ?= workflows/drilling-rz.toml   # the product's main job: a small drilling run in (r, z); elastic smoke: SCENE=workflows/smoke.toml
 
 .PHONY: setup run test bench clean
-setup: build/.apt-ok $(VENV)/.ok build/plugins/MUMPS_mpi.so build/plugins/wendel_petsc.so build/plugins/wendel_tool.so
+setup: build/.apt-ok $(VENV)/.ok build/plugins/MUMPS_mpi.so build/plugins/wendel_petsc.so build/plugins/wendel_tool.so \
+       build/plugins/wendel_kernels.so
 
 # Debian packages: FreeFEM, Open MPI, OpenBLAS under FreeFEM's direct solvers, Mesa for off-screen pictures.
 build/.apt-ok: Makefile scripts/apt-ensure.sh
@@ -39,6 +40,11 @@ build/plugins/wendel_petsc.so: edp/plugins/wendel_petsc.cpp build/.apt-ok
 	g++ -shared -fPIC -O2 -Wall -Wno-unused-variable -Wno-sign-compare -Wno-mismatched-new-delete -isystem /usr/include/freefem++ -isystem $(PETSC_DIR)/include \
 	  -I/usr/lib/x86_64-linux-gnu/openmpi/include -DOMPI_SKIP_MPICXX $< -o $@ \
 	  -L$(PETSC_DIR)/lib -Wl,-rpath,$(PETSC_DIR)/lib -lpetsc_real -lmpi
+
+# wendel's compiled element kernels (lib/kernels.idp, numerics.assembly = "compiled"): no library beyond FreeFEM.
+build/plugins/wendel_kernels.so: edp/plugins/wendel_kernels.cpp build/.apt-ok
+	@mkdir -p build/plugins
+	g++ -shared -fPIC -O2 -Wall -Wno-unused-variable -Wno-sign-compare -Wno-mismatched-new-delete -isystem /usr/include/freefem++ $< -o $@
 
 # wendel's tool plugin (lib/tool.idp): signed distance to a closed triangulated surface (an STL tool).
 build/plugins/wendel_tool.so: edp/plugins/wendel_tool.cpp build/.apt-ok

@@ -75,6 +75,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("names", nargs="*", help="benchmarks to run (default: all of these):\n"
                    "  axisymmetric, cylinder, dg, dg-3d, drilling, elasticity, friction, obstacle, petsc, remesh,\n"
                    "  step42, sweep, thermal, ul,\n"
+                   "  kernels (compiled element kernels against the varf forms on the ball, 2 min),\n"
                    "  necking (Simo's necking bar on 3 meshes, with and without F-bar),\n"
                    "  oxley, oxley-domain, oxley-kienzle (the analytic orthogonal cut);\n"
                    "only when named: step42-dealii, overhead, gmsh3d,\n"

@@ -9,7 +9,7 @@ problems (:class:`wendel.scene.blocks.Problem`) name their own entry script and 
 from __future__ import annotations
 
 from ..meshes import LABELS
-from ..scene import petsc
+from ..scene import kernels, petsc
 from ..scene import axisymmetric
 from ..scene.blocks import BLOCKS, PROBLEMS, discretization
 from ..scene.blocks.contact import in_current_configuration
@@ -58,6 +58,7 @@ def macros(scene: Scene, dimension: int) -> list[str]:
         switches.append("-DWITHFRICTION=1")      # friction, tool, path or force control: edp/lib/friction.idp
     if scene.numerics.solver == "petsc":
         switches.append("-DWITHPETSC=1")       # loads wendel's PETSc plugin (lib/petsc.idp)
+    switches += kernels.macros(scene, dimension)     # -DWITHKERNELS=1: compiled element kernels (lib/kernels.idp)
     return switches
 
 

@@ -21,6 +21,7 @@ from .blocks import BLOCKS, PROBLEMS, choice, load_all
 from ..results.comparisons import COMPARISONS
 from ..meshes import BUILDERS
 from .petsc import PRECONDITIONERS, PcName, check_options
+from .kernels import ASSEMBLIES, check as check_kernels
 from .axisymmetric import REFERENCES as AXI_REFERENCES, check as check_axisymmetric
 
 # Names a scene may use, mapped to the integer ids of edp/lib/loads.idp (never code).
@@ -34,6 +35,7 @@ SolverName = choice(SOLVERS, "solver")
 AnalyticName = choice(ANALYTIC_REFERENCES, "analytic reference")
 ComparisonName = choice(COMPARISONS, "comparison")
 KinematicsName = choice(KINEMATICS, "kinematics")
+AssemblyName = choice(ASSEMBLIES, "assembly")
 AxiReferenceName = choice(AXI_REFERENCES, "axisymmetric reference")
 
 
@@ -192,6 +194,8 @@ class Numerics(Strict):
     newton_maxit: int = Field(25, ge=1, le=500, description="Newton iterations per increment")
     timeout: float = Field(3600.0, gt=0, description="wall-time limit of one FreeFEM launch [s]")
     petsc: Petsc = Field(default_factory=Petsc, description="PETSc solver settings (solver = \"petsc\")")
+    assembly: AssemblyName = Field("freefem", description="tangent, internal forces and strains: freefem (the varf "
+                                   "forms) or compiled (C++ element kernels: 3D P1 small-strain J2 plasticity)")
     max_elements: float = Field(3e6, gt=0, description="refuse a mesh estimated above this many elements before "
                                 "meshing (about 1 GB per 300k 3D elements here; raise it on a bigger machine) [1]")
     max_increments: int = Field(100000, ge=1, description="refuse a load path of more increments than this [1]")
@@ -362,6 +366,7 @@ class SceneBase(Strict):
             raise ValueError("kinematics.volumetric needs kinematics.kind = \"updated-lagrangian\"")
         if self.body_force.kind == "manufactured" and self.reference.analytic is None:
             raise ValueError("body_force.kind = \"manufactured\" needs reference.analytic")
+        check_kernels(self)                # numerics.assembly = "compiled" against the other tables
         if self.problem == "mechanics":
             check_axisymmetric(self)       # elasticity.plane/order/reference against the other tables
         return self

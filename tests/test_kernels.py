@@ -1,0 +1,85 @@
+"""Compiled element kernels (numerics.assembly = "compiled": edp/plugins/wendel_kernels.cpp through lib/kernels.idp)
+against the FreeFEM-language forms on step-42's ball (contact + J2 plasticity, 3D P1): the same Newton and
+Krylov iterations, active set and fields to round-off; scenes the kernels do not cover are refused."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from wendel.loop import run_scene
+from wendel.scene import load
+
+from conftest import WORKFLOWS
+
+
+def ball(out, assembly: str, solver: str = "cg", ranks: int = 1) -> tuple[dict, np.ndarray]:
+    path = WORKFLOWS / "ball-indent.toml"
+    scene = load(path, smoke=True)
+    scene.numerics.solver = solver
+    scene.numerics.ranks = ranks
+    scene.numerics.assembly = assembly
+    scene.output.png = False
+    scene.output.vtu = False
+    root = run_scene(scene, path, out, smoke=True, progress=lambda *_: None)
+    u = sorted(root.glob("fem/inc-*/u.node.txt"))[-1].read_text().split()[1:]
+    return json.loads((root / "summary.json").read_text()), np.array([float(x) for x in u])
+
+
+@pytest.fixture(scope="module")
+def ball_freefem(tmp_path_factory):
+    return ball(tmp_path_factory.mktemp("freefem"), "freefem")
+
+
+def test_compiled_kernels_reproduce_the_varf_assembly(tmp_path, ball_freefem):
+    (f, uf), (c, uc) = ball_freefem, ball(tmp_path / "compiled", "compiled")
+    assert f["completed"] and c["completed"]
+    lf, lc = f["last_increment"], c["last_increment"]
+    assert lf["plastic_points"] > 0 and lf["contact_active_nodes"] > 0      # the kernels' whole tangent is used
+    assert c["newton_iterations"] == f["newton_iterations"]
+    assert lc["linear_iterations"] == lf["linear_iterations"]
+    assert lc["contact_active_nodes"] == lf["contact_active_nodes"]
+    assert lc["plastic_points"] == lf["plastic_points"]
+    for key in ("contact_force", "max_von_mises", "plastic_volume", "max_plastic_strain"):
+        assert lc[key] == pytest.approx(lf[key], rel=1e-10), key
+    assert np.abs(uc - uf).max() <= 1e-10 * np.abs(uf).max()
+    # the point of the kernels: the assembly of the Newton step is cheaper than FreeFEM's forms
+    assert lc["time_tangent"] < lf["time_tangent"]
+
+
+def test_compiled_kernels_on_two_petsc_ranks(tmp_path, ball_freefem):
+    """Every rank runs the kernels on the whole mesh; PETSc solves on both: the same iterates."""
+    (f, uf), (c, uc) = ball_freefem, ball(tmp_path / "np2", "compiled", solver="petsc", ranks=2)
+    assert c["last_increment"]["ranks"] == 2
+    assert c["newton_iterations"] == f["newton_iterations"]
+    assert c["last_increment"]["contact_force"] == pytest.approx(f["last_increment"]["contact_force"], rel=1e-7)
+    assert np.abs(uc - uf).max() <= 1e-7 * np.abs(uf).max()
+
+
+def test_compiled_kernels_with_the_direct_solver(tmp_path):
+    """The direct solver factorizes the kernels' matrix (contact lifted through K, not masked): the same iterates."""
+    (f, uf), (c, uc) = (ball(tmp_path / a, a, solver="direct") for a in ("freefem", "compiled"))
+    assert c["newton_iterations"] == f["newton_iterations"]
+    assert c["last_increment"]["contact_force"] == pytest.approx(f["last_increment"]["contact_force"], rel=1e-10)
+    assert np.abs(uc - uf).max() <= 1e-10 * np.abs(uf).max()
+
+
+@pytest.mark.parametrize("scene, extra, why", [
+    ("hertz-3d", "", "needs a [plasticity] table"),
+    ("ul-tension-3d", "", "small-strain"),
+    ("cylinder", "", "a 3D body"),
+])
+def test_compiled_assembly_refused_where_it_does_not_apply(tmp_path, scene, extra, why):
+    text = (WORKFLOWS / f"{scene}.toml").read_text()
+    text = text.replace("[numerics]", "[numerics]\nassembly = \"compiled\"", 1) if "[numerics]" in text \
+        else text + "\n[numerics]\nassembly = \"compiled\"\n"
+    bad = tmp_path / "bad.toml"
+    bad.write_text(text + extra)
+    r = subprocess.run([sys.executable, "-m", "wendel.cli", "check", str(bad)], capture_output=True, text=True)
+    assert r.returncode == 2
+    assert "numerics.assembly" in r.stderr and why in r.stderr and "bad.toml" in r.stderr
+    assert "Traceback" not in r.stderr
