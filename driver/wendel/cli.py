@@ -78,7 +78,8 @@ def main(argv: list[str] | None = None) -> int:
                    "  kernels (compiled element kernels against the varf forms on the ball, 2 min),\n"
                    "  necking (Simo's necking bar on 3 meshes, with and without F-bar),\n"
                    "  oxley, oxley-domain, oxley-kienzle (the analytic orthogonal cut);\n"
-                   "only when named: step42-dealii, overhead, gmsh3d,\n"
+                   "only when named: step42-dealii, step42-pair (deal.II and wendel interleaved, about 8 minutes),\n"
+                   "  overhead, gmsh3d,\n"
                    "  cutting, cutting-isothermal (the FE orthogonal cut, about 15 minutes each),\n"
                    "  drilling-3d (the 3D deep bore, all 50 removal steps, about 7 minutes),\n"
                    "  necking-fine (the necking bar on a finer and on remeshed meshes, about 4 minutes)")
