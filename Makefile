@@ -11,7 +11,7 @@ APT_PACKAGES := freefem++ libfreefem++-dev openmpi-bin libopenblas0-pthread g++ 
 APT_TEST_PACKAGES := slurmctld slurmd slurm-client slurmdbd munge mariadb-server
 SCENE ?= workflows/drilling-rz.toml   # the product's main job: a small drilling run in (r, z); elastic smoke: SCENE=workflows/smoke.toml
 
-.PHONY: setup run test bench clean
+.PHONY: setup run test bench dealii clean
 setup: build/.apt-ok $(VENV)/.ok build/plugins/MUMPS_mpi.so build/plugins/wendel_petsc.so build/plugins/wendel_tool.so \
        build/plugins/wendel_kernels.so
 
@@ -65,6 +65,14 @@ test: setup build/.apt-test-ok
 
 bench: setup
 	$(VENV)/bin/wendel bench
+
+# deal.II 9.4, the peer of `wendel bench step42-dealii` and `step42-pair` (about 190 packages; nothing else needs it).
+APT_PEER_PACKAGES := libdeal.ii-dev libdeal.ii-doc cmake
+dealii: setup build/.apt-peer-ok
+build/.apt-peer-ok: Makefile scripts/apt-ensure.sh
+	@mkdir -p build
+	scripts/apt-ensure.sh "peer packages (deal.II)" $(APT_PEER_PACKAGES)
+	@touch $@
 
 clean:
 	rm -rf build results

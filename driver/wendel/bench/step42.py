@@ -132,7 +132,7 @@ def plot_force_vs_time(png: Path, rows: list[dict], dealii: list[tuple] | None =
 def _dealii_build(workdir: Path) -> Path:
     """Configure and build step-42 from libdeal.ii-doc in release mode; return the executable."""
     if not (DEALII_EXAMPLE / "step-42.cc").is_file():
-        raise RuntimeError("deal.II's step-42 is not installed: apt-get install libdeal.ii-dev libdeal.ii-doc cmake")
+        raise RuntimeError("deal.II's step-42 is not installed: `make dealii` (apt-get install libdeal.ii-dev libdeal.ii-doc cmake)")
     src = workdir / "src"
     exe = src / "step-42"
     if exe.is_file():
