@@ -11,7 +11,6 @@ import os
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
-import meshio
 import numpy as np
 
 CELL_TYPES = {2: "triangle", 3: "tetra"}
@@ -67,6 +66,7 @@ def write_array(path: Path, values) -> None:
 
 def read_mesh(path: Path, dimension: int) -> tuple[np.ndarray, np.ndarray]:
     """Points (n, 3) and the cells of the given dimension of a gmsh file."""
+    import meshio       # here: its import (0.2 s) is off a run's critical path (wendel.loop.overlap.preload)
     m = meshio.read(path, file_format="gmsh")
     cells = np.concatenate([b.data for b in m.cells if b.type == CELL_TYPES[dimension]])
     return m.points, cells
@@ -123,6 +123,7 @@ def current_points(point_data: dict, points: np.ndarray) -> np.ndarray:
 
 def write_vtu(path: Path, points, cells, dimension: int, point_data, cell_data) -> None:
     """Write one VTU (atomic: written beside, then renamed)."""
+    import meshio
     mesh = meshio.Mesh(points, [(CELL_TYPES[dimension], cells)], point_data=point_data, cell_data=cell_data)
     tmp = path.with_suffix(".tmp.vtu")
     meshio.write(tmp, mesh, binary=True)
