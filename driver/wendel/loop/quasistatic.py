@@ -95,6 +95,8 @@ def run_scene(scene: Scene, scene_path: Path, out: Path, smoke: bool = False, pr
         with guarded(files.root):
             return run_drilling(scene, scene_path, files.root, smoke, progress)
     with guarded(files.root):
+        if scene.output.png:
+            pictures.prestart()        # the renderer starts while the driver meshes (issue 20)
         summary.write_provenance(files.root, Path(scene_path), scene, smoke)
         state = State(pending=scene.loading.load_factors())
         state.mesh_seconds, dimension = build(scene, files)
@@ -109,7 +111,7 @@ def _execute(scene: Scene, files: RunFiles, state: State, progress) -> Path:
     progress(f"wendel: {scene.description}")
     progress(f"  run folder {files.root}")
     # the picture process starts its renderer while FreeFEM solves
-    with pictures.Painter(pictures.renderer(files.mesh)) if scene.output.png else contextlib.nullcontext() as painter:
+    with pictures.painter(pictures.renderer(files.mesh)) if scene.output.png else contextlib.nullcontext() as painter:
         _solve_and_report(scene, files, state, dimension, progress, painter)
     return files.root
 
