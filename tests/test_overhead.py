@@ -155,3 +155,35 @@ def test_accepting_while_freefem_solves_gives_the_same_run(tmp_path, monkeypatch
         assert a.point_data.keys() == b.point_data.keys() and a.cell_data.keys() == b.cell_data.keys()
         for k in a.point_data:
             np.testing.assert_allclose(a.point_data[k], b.point_data[k], rtol=1e-9, atol=1e-14)
+    # the cell fields are binary (BinaryIO's SaveVec: int64 count, float64 values) and read as the VTU holds them
+    from wendel.results.vtu import complete_array, read_array
+    last = sorted((behind / "vtu").glob("inc-*.vtu"))[-1]
+    cell_data = meshio.read(last).cell_data
+    files = sorted((behind / "fem" / last.stem).glob("*.cell.txt"))
+    assert len(files) == len(cell_data) > 5
+    for f in files:
+        raw = f.read_bytes()
+        assert raw[7] == 0 and len(raw) == 8 + 8 * int.from_bytes(raw[:8], "little") and complete_array(f), f
+        np.testing.assert_array_equal(read_array(f), np.ravel(cell_data[f.name.removesuffix(".cell.txt")][0]))
+    cut = tmp_path / "cut.cell.txt"
+    cut.write_bytes(raw[:-3])
+    assert not complete_array(cut)
+    with pytest.raises(ValueError, match="header says"):
+        read_array(cut)
+
+
+def test_the_run_takes_the_picture_process_started_before_its_mesh():
+    """pictures.prestart (a run, before meshing): the run's painter is that process when the renderer is
+    the same; otherwise it is stopped and another started."""
+    from wendel.results import pictures
+
+    pictures.prestart("matplotlib")
+    early = pictures._EARLY[0]
+    with pictures.painter("matplotlib") as p:
+        assert p is early and not pictures._EARLY
+    assert early.proc.wait(timeout=10) == 0
+    pictures.prestart("matplotlib")
+    early = pictures._EARLY[0]
+    other = pictures.painter("pyvista")
+    other.close(at_once=True)
+    assert other is not early and not pictures._EARLY and early.proc.poll() is not None

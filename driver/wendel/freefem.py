@@ -14,6 +14,7 @@ import json
 import os
 import re
 import shutil
+import select
 import signal
 import subprocess
 import tempfile
@@ -148,6 +149,8 @@ def run(entry: str, options: list[str], out_dir: Path, ranks: int = 1, timeout: 
     # ("orte_session_dir failed") when the first to finish removed it
     session = tempfile.mkdtemp(prefix="wendel-ompi-")
     env.setdefault("OMPI_MCA_orte_tmpdir_base", session)
+    if singleton:       # no orted beside the singleton: 0.1 s less per launch here (issue 20)
+        env.setdefault("OMPI_MCA_ess_singleton_isolated", "1")
     t0 = time.perf_counter()
     with open(log, "a") as flog:
         flog.write("$ " + " ".join(cmd) + "\n")
@@ -155,7 +158,7 @@ def run(entry: str, options: list[str], out_dir: Path, ranks: int = 1, timeout: 
         proc = subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=flog, stderr=subprocess.STDOUT, env=env,
                                 start_new_session=True, cwd=out_dir)
         try:
-            rc = proc.wait(timeout=timeout)
+            rc = _wait(proc, timeout)
         except subprocess.TimeoutExpired:
             _kill(proc)
             raise FreeFemTimeout(f"{entry}: stopped after the time limit of {timeout:g} s (numerics.timeout)",
@@ -200,6 +203,23 @@ def alive(pid: int) -> bool:
         return True
     except ProcessLookupError:
         return False
+
+
+def _wait(proc: subprocess.Popen, timeout: float) -> int:
+    """``proc.wait(timeout)`` woken by the process's end itself (a pidfd) rather than by Popen's polling,
+    whose sleeps grow to 0.05 s: up to 0.05 s less per launch (issue 20)."""
+    try:
+        fd = os.pidfd_open(proc.pid)
+    except (AttributeError, OSError):        # not Linux >= 5.3
+        return proc.wait(timeout=timeout)
+    try:
+        poller = select.poll()
+        poller.register(fd, select.POLLIN)
+        if not poller.poll(max(timeout, 0.0) * 1000.0):
+            raise subprocess.TimeoutExpired(proc.args, timeout)
+    finally:
+        os.close(fd)
+    return proc.wait()
 
 
 def _kill(proc: subprocess.Popen) -> None:

@@ -89,11 +89,14 @@ def run_scene(scene: Scene, scene_path: Path, out: Path, smoke: bool = False, pr
     except OSError as exc:
         raise RunFolderError(f"run folder (--out) {out}: cannot be created or written: {exc.strerror}") from None
     check_size(scene, str(scene_path))       # h may have been scaled since the scene was read (studies)
+    overlap.preload("meshio")     # imported while gmsh meshes and FreeFEM starts, not at the first VTU
     if getattr(scene, "drilling", None) is not None:      # a process of removal steps: wendel.loop.drilling
         from .drilling import run as run_drilling
         with guarded(files.root):
             return run_drilling(scene, scene_path, files.root, smoke, progress)
     with guarded(files.root):
+        if scene.output.png:
+            pictures.prestart()        # the renderer starts while the driver meshes (issue 20)
         summary.write_provenance(files.root, Path(scene_path), scene, smoke)
         state = State(pending=scene.loading.load_factors())
         state.mesh_seconds, dimension = build(scene, files)
@@ -104,10 +107,11 @@ def run_scene(scene: Scene, scene_path: Path, out: Path, smoke: bool = False, pr
 def _execute(scene: Scene, files: RunFiles, state: State, progress) -> Path:
     """Solve the pending increments, then summary and picture."""
     dimension = json.loads(files.checkpoint.read_text())["dimension"]
+    overlap.preload("meshio")         # a resumed run
     progress(f"wendel: {scene.description}")
     progress(f"  run folder {files.root}")
     # the picture process starts its renderer while FreeFEM solves
-    with pictures.Painter(pictures.renderer(files.mesh)) if scene.output.png else contextlib.nullcontext() as painter:
+    with pictures.painter(pictures.renderer(files.mesh)) if scene.output.png else contextlib.nullcontext() as painter:
         _solve_and_report(scene, files, state, dimension, progress, painter)
     return files.root
 

@@ -1,8 +1,9 @@
 """FreeFEM's field files to ParaView: one VTU per increment, a PVD index (pictures: :mod:`.pictures`).
 
 FreeFEM writes nodal fields (``name.node.txt``, P1 values in the node order of the mesh file,
-components interleaved) and cell fields (``name.cell.txt``); this module turns them into VTU with
-meshio, in float64, with 2D vectors padded to 3 components so ParaView can warp by them.
+components interleaved) and cell fields (``name.cell.txt``, binary: :func:`read_array`); this module
+turns them into VTU with meshio, in float64, with 2D vectors padded to 3 components so ParaView can warp
+by them.
 """
 
 from __future__ import annotations
@@ -11,22 +12,41 @@ import os
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
-import meshio
 import numpy as np
 
 CELL_TYPES = {2: "triangle", 3: "tetra"}
 
 
 def read_array(path: Path) -> np.ndarray:
-    """Read edp's plain array format: the count, then the values (any whitespace)."""
-    with open(path) as f:
-        data = np.array(f.read().split(), dtype=float)
+    r"""Read edp's array formats: text (the count, then the values, any whitespace) or binary (FreeFEM's
+    BinaryIO ``SaveVec``, cell fields: the count as a little-endian int64, then float64 values).
+
+    >>> import tempfile; d = Path(tempfile.mkdtemp())
+    >>> _ = (d / "t.txt").write_text("2\t\n\t0.5\t-1e-300\t")
+    >>> _ = (d / "b.txt").write_bytes((2).to_bytes(8, "little") + np.array([0.5, -1e-300]).tobytes())
+    >>> read_array(d / "t.txt").tolist() == read_array(d / "b.txt").tolist() == [0.5, -1e-300]
+    True
+    """
+    with open(path, "rb") as f:
+        raw = f.read()
+    if _binary(raw):
+        n = int.from_bytes(raw[:8], "little")
+        if len(raw) != 8 + 8 * n:
+            raise ValueError(f"{path}: header says {n} values, found {(len(raw) - 8) / 8:g} (binary)")
+        return np.frombuffer(raw, dtype="<f8", offset=8, count=n).astype(float)
+    data = np.array(raw.split(), dtype=float)
     if data.size == 0:
         raise ValueError(f"{path}: empty array file")
     n = int(data[0])
     if data.size - 1 != n:
         raise ValueError(f"{path}: header says {n} values, found {data.size - 1}")
     return data[1:]
+
+
+def _binary(raw: bytes) -> bool:
+    """Whether an array file is binary: its int64 count has a zero high byte (below 2^56 values), a NUL that
+    text never holds."""
+    return len(raw) >= 8 and raw[7] == 0
 
 
 def complete_array(path: Path) -> bool:
@@ -43,6 +63,8 @@ def complete_array(path: Path) -> bool:
     """
     try:
         data = path.read_bytes()
+        if _binary(data):
+            return len(data) == 8 + 8 * int.from_bytes(data[:8], "little")
         head, _, body = data.partition(b"\n")
         n = int(head)
         rows = -(-n // 5)
@@ -67,6 +89,7 @@ def write_array(path: Path, values) -> None:
 
 def read_mesh(path: Path, dimension: int) -> tuple[np.ndarray, np.ndarray]:
     """Points (n, 3) and the cells of the given dimension of a gmsh file."""
+    import meshio       # here: its import (0.2 s) is off a run's critical path (wendel.loop.overlap.preload)
     m = meshio.read(path, file_format="gmsh")
     cells = np.concatenate([b.data for b in m.cells if b.type == CELL_TYPES[dimension]])
     return m.points, cells
@@ -123,6 +146,7 @@ def current_points(point_data: dict, points: np.ndarray) -> np.ndarray:
 
 def write_vtu(path: Path, points, cells, dimension: int, point_data, cell_data) -> None:
     """Write one VTU (atomic: written beside, then renamed)."""
+    import meshio
     mesh = meshio.Mesh(points, [(CELL_TYPES[dimension], cells)], point_data=point_data, cell_data=cell_data)
     tmp = path.with_suffix(".tmp.vtu")
     meshio.write(tmp, mesh, binary=True)
