@@ -218,6 +218,12 @@ def test_the_notched_plate_separates_across_its_ligament_and_the_force_drops(tmp
         jump = np.array([np.linalg.norm(u[i] - u[j]) for i, j in split])
         # the two copies of a vertex on the cut move apart (a CG field on the uncut mesh has one value there)
         assert np.median(jump) > 0.1 * np.abs(u).max(), (jump, np.abs(u).max())
+        # remeshing the cut body is refused with a message (gmsh did not finish meshing it: measured, > 10 min)
+        remeshed = scene_file(CONTINUE.format(mesh=root / "separated.msh").replace(
+            '[numerics]', '[loading]\nsteps = 2\n[remesh]\nat = [1]\nindicator = ""\n[numerics]'), "cont-remesh.toml")
+        with pytest.raises(ValueError, match="opened faces"):
+            run(remeshed, out=tmp_path / "cont-remesh", png=False, progress=quiet)
+        assert (tmp_path / "cont-remesh" / "fem" / "inc-0001" / "done").is_file()     # increment 1 is kept
 
 
 def test_a_killed_separating_run_resumes_to_the_same_result(tmp_path):

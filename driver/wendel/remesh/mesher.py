@@ -33,6 +33,8 @@ import numpy as np
 from ..meshes.builders import start_gmsh
 from . import quality
 
+OPENED = 31       # meshes/labels.py: "opened", the faces a DG separation opened (separated.msh)
+
 __all__ = ["remesh", "read_mesh", "boundary_facets"]
 
 _VOLUME = {2: "triangle", 3: "tetra"}
@@ -252,6 +254,10 @@ def remesh(points_deformed, mesh_in_path, out_path, h, size_indicator=None, h_mi
                          "remesh from an earlier increment")
     bf = boundary_facets(cells)
     labels = _label_facets(bf, facets, facet_tags)
+    if OPENED in labels:
+        raise ValueError(f"{mesh_in_path}: the body is cut along opened faces (boundary 'opened', label {OPENED}, "
+                         "of a DG separation): remeshing it is not supported (gmsh does not finish meshing the two "
+                         "coincident sides of a cut); continue on this mesh without [remesh]")
     h_min = h / 4 if h_min is None else h_min
 
     start_gmsh()          # keeps the driver's Ctrl-C and SIGTERM handlers
