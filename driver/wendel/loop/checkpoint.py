@@ -6,8 +6,10 @@ dimension and the :class:`State` atomically; :func:`load_state` reads them back.
 
 from __future__ import annotations
 
+import itertools
 import json
 import os
+import threading
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -70,6 +72,10 @@ class State:
         return [s for s in self.segments if s["first"] <= inc][-1]
 
 
+_SAVING = threading.RLock()
+_SERIAL = itertools.count()
+
+
 def save(files: RunFiles, scene: Scene, state: State, dimension: int) -> None:
     data = {"scene": scene.model_dump(mode="json"), "dimension": dimension,
             "accepted": state.accepted, "pending": state.pending, "cuts": state.cuts,
@@ -77,9 +83,20 @@ def save(files: RunFiles, scene: Scene, state: State, dimension: int) -> None:
             "quality": {str(k): v for k, v in state.quality.items()}, "step": state.step,
             "launches": state.launches, "mesh_seconds": state.mesh_seconds, "post_seconds": state.post_seconds,
             "behind_seconds": state.behind_seconds}
-    tmp = files.checkpoint.with_suffix(".tmp")
-    tmp.write_text(json.dumps(data, indent=1))
-    os.replace(tmp, files.checkpoint)
+    text = json.dumps(data, indent=1).encode()
+    # One save at a time (the driver thread and the output thread of loop/overlap.py both save), each through a
+    # temporary file of its own written unbuffered: a save interrupted by Ctrl-C or SIGTERM can then never write
+    # into the checkpoint another save has put in place (measured once: checkpoint.json ended in 17 stray bytes).
+    with _SAVING:
+        tmp = files.checkpoint.with_suffix(f".{os.getpid()}.{next(_SERIAL)}.tmp")
+        fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o644)
+        try:
+            view = memoryview(text)
+            while view:
+                view = view[os.write(fd, view):]
+        finally:
+            os.close(fd)
+        os.replace(tmp, files.checkpoint)
 
 
 def load_state(root: Path) -> tuple[RunFiles, Scene, State, int]:
