@@ -166,14 +166,33 @@ temperature = 300.0      # K
 """ + NUMERICS.format(steps=4)
 
 
-@pytest.mark.parametrize("case", ["plane", "axi"])
+@pytest.mark.parametrize("case", ["plane", "axi", "3d"])
 def test_conduction_through_a_stretched_block_is_that_of_the_current_block(tmp_path, scene_file, quiet, case):
     """Steady conduction between the ends of a block stretched from 1 m to 2 m (elastic, logarithmic strain,
     free lateral contraction): the heat into the hot end is k dT A / L of the current block to 1e-10 (plane
     strain A = the current height per unit thickness; (r, z) a cylinder along z, A = pi r^2); on the launch
-    mesh it would be k dT A0 / L0, more than twice as much."""
+    mesh it would be k dT A0 / L0, more than twice as much. 3D: a flux q = 1 kW/m^2 into the left end (per
+    current area) and 300 K at the right end: the heat out of the right end is q A, the left end at
+    300 K + q L / k (the surface stretch of Nanson's formula and the conduction on the current block)."""
     text = STRETCH
     hot, dim = "left", 2
+    if case == "3d":
+        text = edit(text, 'builder = "rectangle"\nx = [0.0, 1.0]           # m\ny = [0.0, 0.5]           # m\nh = 0.25',
+                    'builder = "box"\nx = [0.0, 1.0]           # m\ny = [0.0, 0.5]           # m\n'
+                    'z = [0.0, 0.5]           # m\nh = 0.5')
+        text = edit(text, "[boundary.bottom]\nuy = 0.0", "[boundary.front]\nuy = 0.0                 # m\n"
+                    "[boundary.bottom]\nuz = 0.0")
+        text = edit(text, "[thermal.boundary.left]\ntemperature = 400.0      # K",
+                    "[thermal.boundary.left]\nflux = 1000.0            # W/m^2")
+        rec, cells, nodes = last(go(scene_file, text, tmp_path, quiet, case))
+        pos = nodes["position"].reshape(-1, 3)
+        ext = pos.max(axis=0) - pos.min(axis=0)
+        assert abs(ext[0] - 2.0) < 1e-10 and ext[1] < 0.45
+        q, area = 1000.0, ext[1] * ext[2]
+        assert abs(rec[f"heat_in_{LABELS['right']}"] / (-q * area) - 1) < 1e-10
+        T_left = nodes["T"][np.abs(pos[:, 0]) < 1e-12]
+        assert np.abs(T_left / (300.0 + q * 2.0 / 50.0) - 1).max() < 1e-10
+        return
     if case == "axi":
         text = edit(text, 'builder = "rectangle"\nx = [0.0, 1.0]           # m\ny = [0.0, 0.5]           # m',
                     'builder = "axi_rectangle"\nr = [0.0, 0.5]           # m\nz = [0.0, 1.0]           # m')
