@@ -101,6 +101,23 @@ uy = 0.0                 # m
 """ + MATERIAL + THERMAL.format(alpha=ALPHA, coupling="staggered", duration=0.0)
               + "[thermal.boundary.right]\ntemperature = 1293.15   # K\n"
               + "[thermal.boundary.top]\ntemperature = 1293.15     # K\n" + NUMERICS.format(steps=2), 2, ALPHA),
+    # the same with perfect plasticity: sigma_zz = -E alpha dT would be 80 sigma0, so the body flows
+    "plane-plastic": ("""description = "UL free thermal expansion, plane strain, perfectly plastic"
+[geometry]
+builder = "rectangle"
+x = [0.0, 0.1]           # m
+y = [0.0, 0.1]           # m
+h = 0.05                 # m
+[boundary.left]
+ux = 0.0                 # m
+[boundary.bottom]
+uy = 0.0                 # m
+[plasticity]
+law = "perfect"
+sigma0 = 250e6           # Pa
+""" + MATERIAL + THERMAL.format(alpha=ALPHA, coupling="monolithic", duration=0.0)
+              + "[thermal.boundary.right]\ntemperature = 1293.15   # K\n"
+              + "[thermal.boundary.top]\ntemperature = 1293.15     # K\n" + NUMERICS.format(steps=2), 2, ALPHA),
     # (r, z) cylinder on its symmetry plane, steady, outer surface and top at 1293.15 K, monolithic
     "axi": ("""description = "UL free thermal expansion, (r, z) cylinder"
 [geometry]
@@ -122,7 +139,8 @@ uy = 0.0                 # m
 def test_free_thermal_expansion_is_stress_free_and_stretches_by_the_exponential(tmp_path, scene_file, quiet, case):
     """A uniformly heated body on symmetry planes: every side stretched by exp(alpha dT) (plane strain: the
     in-plane sides by exp((1 + nu) alpha dT)) to 1e-8 relative, far from 1 + alpha dT; stresses round-off
-    (plane strain: sigma_zz = -E alpha dT)."""
+    (plane strain: sigma_zz = -E alpha dT; perfectly plastic: sigma_zz = -sigma0 and the in-plane stretch
+    exp(1.5 alpha dT - (1/2 - nu) sigma0 / E))."""
     text, dim, alpha = FREE[case]
     rec, cells, nodes = last(go(scene_file, text, tmp_path, quiet, case))
     T = nodes["T"]
@@ -130,10 +148,12 @@ def test_free_thermal_expansion_is_stress_free_and_stretches_by_the_exponential(
     dT = T.mean() - TREF
     assert dT > 500                                                # the run heated it
     stretch = math.exp(((1 + NU) if case == "plane" else 1.0) * alpha * dT)
+    if case == "plane-plastic":     # sigma_zz = -sigma0, eps_zz = 0: the flow takes alpha dT - sigma0 / E off zz
+        stretch = math.exp(1.5 * alpha * dT - (0.5 - NU) * 250e6 / E)
     pos = nodes["position"].reshape(-1, dim)
     size = pos.max(axis=0) - pos.min(axis=0)
     assert np.abs(size / (0.1 * stretch) - 1).max() < 1e-8, (size, stretch)
-    linear = 1 + ((1 + NU) if case == "plane" else 1.0) * alpha * dT
+    linear = 1 + ((1 + NU) if case.startswith("plane") else 1.0) * alpha * dT
     assert abs(stretch - linear) > 1e-4                            # the test tells the two apart
     scale = E * alpha * dT
     names = ["stress_xx", "stress_yy", "stress_xy"] + (["stress_zz", "stress_xz", "stress_yz"] if dim == 3 else [])
@@ -141,6 +161,8 @@ def test_free_thermal_expansion_is_stress_free_and_stretches_by_the_exponential(
         assert np.abs(cells[n]).max() < 1e-10 * scale, (n, np.abs(cells[n]).max())
     if case == "plane":
         assert np.abs(cells["stress_zz"] / (-scale) - 1).max() < 1e-10
+    if case == "plane-plastic":
+        assert np.abs(cells["stress_zz"] / -250e6 - 1).max() < 1e-10
     if case == "axi":
         assert np.abs(cells["stress_zz"]).max() < 1e-10 * scale    # the hoop stress
     assert rec["energy_balance_error"] < 1e-10
