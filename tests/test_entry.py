@@ -26,16 +26,19 @@ GUARDS = {"plasticity": "wendelPlasticityIdp", "contact": "wendelContactIdp", "t
           "axisymmetric": "wendelAxisymmetricIdp", "axisymmetric-mechanics": "wendelAxisymmetricMechanicsIdp",
           "remeshstop": "wendelRemeshStopIdp", "kinematics": "wendelKinematicsIdp",
           "friction": "wendelFrictionIdp", "tool": "wendelToolIdp", "petsc": "wendelPetscIdp", "dg": "wendelDgIdp",
-          "dg3d": "wendelDg3dIdp"}
+          "dg3d": "wendelDg3dIdp", "kinematics-thermal": "wendelKinematicsThermalIdp"}
 MODULES = ("plasticity", "contact", "thermal", "thermal-fields", "axisymmetric", "axisymmetric-mechanics", "remeshstop",
-           "kinematics", "friction", "tool", "dg", "dg3d")
+           "kinematics", "friction", "tool", "dg", "dg3d", "kinematics-thermal")
 
 
-def compiled(tmp_path, scene_name: str, solver: str | None = None) -> tuple[set[str], list[str], dict]:
+def compiled(tmp_path, scene_name: str, solver: str | None = None, kinematics: str | None = None
+             ) -> tuple[set[str], list[str], dict]:
     """Launch the scene's entry at verbosity 1; return (modules compiled, -D switches, first record)."""
     scene = load(WORKFLOWS / scene_name, smoke=True)
     if solver:
         scene.numerics.solver = solver
+    if kinematics:
+        scene.kinematics.kind = kinematics
     files = RunFiles(tmp_path / scene_name.removesuffix(".toml"))
     files.root.mkdir(parents=True)
     dimension = build(scene.geometry.builder, files.mesh, **scene.geometry.params).dimension
@@ -84,6 +87,17 @@ def test_only_a_petsc_scene_loads_the_petsc_plugin(tmp_path):
 def test_updated_lagrangian_kinematics_is_compiled_only_when_the_scene_asks(tmp_path):
     found, switches, _ = compiled(tmp_path, "ul-tension.toml")
     assert found & set(MODULES) == {"plasticity", "kinematics"} and "-DUPDATEDLAGRANGIAN=1" in switches
+
+
+def test_updated_lagrangian_heat_compiles_its_forms_only_with_both_switches(tmp_path):
+    """thermo-free.toml with updated-Lagrangian kinematics: the heat equation on the current configuration
+    (kinematics-thermal.idp) beside thermal and kinematics; ul-tension.toml (no [thermal]) and thermo-indent.toml
+    (small strain) do not compile it (test_updated_lagrangian_kinematics_is_compiled_only_when_the_scene_asks,
+    test_each_block_compiles_its_module_and_only_it)."""
+    found, switches, record = compiled(tmp_path, "thermo-free.toml", kinematics="updated-lagrangian")
+    assert found & set(MODULES) == {"thermal", "thermal-fields", "kinematics", "kinematics-thermal"}, found
+    assert "-DUPDATEDLAGRANGIAN=1" in switches and "-DWITHTHERMAL=1" in switches
+    assert record["max_temperature"] > 393.0
 
 
 def test_a_value_of_zero_still_switches_a_module_on(tmp_path):
