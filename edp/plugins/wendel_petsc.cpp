@@ -335,7 +335,10 @@ PetscErrorCode solve(Matrice_Creuse<double>* K, KN<double>* b, KN<double>* x, KN
         if (reason > 0) {
             double fresh = cache.rateAtSetup > 0 ? digits / cache.rateAtSetup : 0;
             if (its > 0 && its > fresh) cache.extraCost += (its - fresh) * (t3 - t2) / its;
-            if (cache.extraCost > cache.setupCost) cache.stale = true;   // set up anew at the next solve
+            int stale = cache.extraCost > cache.setupCost;                // set up anew at the next solve
+            if (cache.size > 1)                // times differ between ranks: the setup is collective, decide together
+                PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &stale, 1, MPI_INT, MPI_MAX, PETSC_COMM_WORLD));
+            if (stale) cache.stale = true;
             break;
         }
         cache.stale = true;                                               // the kept one failed: set up and solve again
