@@ -198,10 +198,11 @@ def test_the_run_takes_the_picture_process_started_before_its_mesh():
     assert other is not early and not pictures._EARLY and early.proc.poll() is not None
 
 
-@pytest.mark.parametrize("scene", ["smoke", "hertz-3d"])
+@pytest.mark.parametrize("scene", ["smoke", "hertz-3d", "thermo-constrained"])
 def test_elastic_strain_energy_on_one_point_is_the_integral_of_its_cell_fields(scene, tmp_path):
-    """Elastic P1 (2D plane strain, 3D): the record's strain energy (FreeFEM's one-point rule since issue 20)
-    equals 0.5 sum over cells |K| sigma : eps, computed here from the VTU's cell strains, E and nu."""
+    """Elastic P1 (2D plane strain, 3D, 3D with a thermal stress): the record's strain energy (FreeFEM's
+    one-point rule since issue 20) equals 0.5 sum over cells |K| sigma : eps, computed here from the VTU's
+    cell strains, E and nu (and alpha, the temperature at the cell's centroid)."""
     from wendel.loop import run
 
     root = run(WORKFLOWS / f"{scene}.toml", smoke=True, out=tmp_path / scene, progress=lambda *a: None)
@@ -222,6 +223,10 @@ def test_elastic_strain_energy_on_one_point_is_the_integral_of_its_cell_fields(s
     eps = {(a, b): np.concatenate(m.cell_data[f"strain_{min(a, b)}{max(a, b)}"]) for a in axes for b in axes}
     trace = sum(eps[a, a] for a in axes)
     density = sum((lam * trace * (a == b) + 2 * mu * eps[a, b]) * eps[a, b] for a in axes for b in axes)
+    thermal = json.loads((root / "scene.resolved.json").read_text()).get("thermal")
+    if thermal:           # sigma = C eps - 3 K alpha (T - T_ref) I, T linear: its centroid value
+        t_centroid = np.asarray(m.point_data["T"])[cells].mean(axis=1)
+        density = density - 3 * (lam + 2 * mu / 3) * thermal["alpha"] * (t_centroid - thermal["T_ref"]) * trace
     energy = 0.5 * (vol * density).sum()
     record = json.loads(sorted((root / "fem").glob("inc-*/record.json"))[-1].read_text())
     assert energy > 0
