@@ -183,3 +183,24 @@ def _add_curves(gmsh, pts, chains, groups, next_curve, points_done):
     return tags
 
 
+
+
+def inside_targets(points: np.ndarray, cells: np.ndarray, on: np.ndarray) -> np.ndarray:
+    """The nodes ``points`` with those in ``on`` (nodes on a cut) moved 1e-3 of the way to the mean centroid of
+    their own cells: located in the old mesh, whose cut lies where the new one's does, each side of the cut
+    then finds its own side (its two copies of a node sit at the same place).
+
+    >>> inside_targets(np.array([[0., 0], [1, 0], [0, 1]]), np.array([[0, 1, 2]]), np.array([0])).round(6).tolist()
+    [[0.000333, 0.000333], [1.0, 0.0], [0.0, 1.0]]
+    """
+    if len(on) == 0:
+        return points
+    centre = np.zeros((len(points), points.shape[1]))
+    count = np.zeros(len(points))
+    c = points[cells].mean(axis=1)
+    for k in range(cells.shape[1]):
+        np.add.at(centre, cells[:, k], c)
+        np.add.at(count, cells[:, k], 1.0)
+    out = np.array(points, dtype=float)
+    out[on] += 1e-3 * (centre[on] / count[on, None] - out[on])
+    return out
