@@ -28,7 +28,7 @@ from .checkpoint import RunFiles, State, committed, save as _save_checkpoint
 from . import overlap, separated
 from .guard import disk_full as _disk_full, guarded
 from .resume import is_drilling, restart, resume as resume_run, resume_drilling
-from .launch import entry_script, macros, options, write_tables
+from .launch import options, write_tables
 from .progress import _Progress
 from .steps import cut_step, grow_step, plan_step
 
@@ -124,11 +124,9 @@ def _solve_and_report(scene: Scene, files: RunFiles, state: State, dimension: in
         if scene.remesh and state.accepted and state.pending and not state.reequilibrate \
                 and not after_reequilibration:
             maybe_remesh(scene, files, state, dimension, progress)    # a run resumed before the decision
-        if separated.maybe_switch(scene, files, state, dimension, progress):     # (the same, DG -> CG)
-            _save_checkpoint(files, scene, state, dimension)
+        separated.maybe_switch(scene, files, state, dimension, progress)     # (the same, DG -> CG)
         solve(scene, files, state, dimension, progress)
-        if state.segments[-1].get("discretization") != separated.CG:       # (else written at the switch)
-            separation.after_run(scene, files, state, progress)
+        separation.after_run(scene, files, state, progress)
     finally:
         with contextlib.suppress(OSError):       # a full disk must not hide why the run stopped
             summary.write_summary(files.root, scene, state, dimension)
@@ -182,9 +180,7 @@ def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress)
     while state.pending:
         inc0 = state.last[0] + 1
         seg = state.segment(inc0)
-        seg_scene = separated.segment_scene(scene, seg)     # CG after a DG separation (loop/separated.py)
-        entry = entry_script(seg_scene, dimension)
-        switches = macros(seg_scene, dimension) + separated.macros(seg)
+        seg_scene, entry, switches, extra = separated.launch(scene, seg, dimension)    # CG after a DG separation
         if scene.loading.adaptive and not state.reequilibrate:
             plan_step(scene, state)
         was_reequilibration = state.reequilibrate
@@ -194,11 +190,10 @@ def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress)
         (files.fem / remesh_batch.STOP_FILE).unlink(missing_ok=True)
         loads = files.tables / "loads.txt"
         loads.write_text(f"{len(batch)}\n" + "".join(f"{lf!r}\n" for lf in batch))
-        opts = options(seg_scene, files, dimension, seg) + separated.options(seg) + ["-loads", str(loads), "-inc0", str(inc0)]
+        opts = options(seg_scene, files, dimension, seg) + extra + ["-loads", str(loads), "-inc0", str(inc0)]
         if state.reequilibrate:
             opts += ["-restart", str(files.root / seg["state"]), "-relax_steps",
-                     str(state.remeshes[-1]["relax_steps"] if "relax_steps" in state.remeshes[-1]
-                         else scene.remesh.relax_steps)]
+                     str(state.remeshes[-1].get("relax_steps") or scene.remesh.relax_steps)]
         elif state.accepted:
             opts += ["-restart", str(files.fem / f"inc-{state.last[0]:04d}")]
         watcher = _Progress(files.fem, inc0, len(batch), batch, progress)
@@ -284,8 +279,7 @@ def accept(scene: Scene, files: RunFiles, state: State, dimension: int) -> None:
             vtu.write_vtu(files.vtu / f"inc-{inc:04d}.vtu", at, cells, dimension, pdata, cdata)
         state.accepted.append((inc, record["load_factor"]))
         state.pending.pop(0)
-        summary.append_history(files.root, {**record, **extra, **separated.history_extra(record, seg)},
-                               d / "newton.csv")
+        summary.append_history(files.root, separated.history_row(record, extra, seg), d / "newton.csv")
         _save_checkpoint(files, scene, state, dimension)
     if scene.output.vtu and state.accepted:
         vtu.write_pvd(files.root / "results.pvd",

@@ -29,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from ..results import separation, vtu
+from .checkpoint import save
 
 CG = "cg"
 
@@ -44,14 +45,18 @@ def segment_scene(scene, segment: dict):
     return cg
 
 
-def macros(segment: dict) -> list[str]:
-    return ["-DWITHREACTIONS=1"] if segment.get("discretization") == CG else []
+def launch(scene, segment: dict, dimension: int):
+    """(scene, entry script, -D switches, extra options) of a launch on ``segment``. The CG segment's residual
+    scale is at least DG's largest volume-force norm (dg_scale.txt): the separated bodies carry (almost) no
+    force, and a residual relative to nothing would not converge."""
+    from .launch import entry_script, macros
 
-
-def options(segment: dict) -> list[str]:
-    """The CG segment's residual scale: at least DG's largest volume-force norm (dg_scale.txt), since the
-    separated bodies carry (almost) no force and a relative residual of nothing would not converge."""
-    return ["-newton_ref_min", repr(float(segment["ref_min"]))] if segment.get("discretization") == CG else []
+    sc = segment_scene(scene, segment)
+    switches = macros(sc, dimension)
+    if segment.get("discretization") != CG:
+        return sc, entry_script(sc, dimension), switches, []
+    return sc, entry_script(sc, dimension), switches + ["-DWITHREACTIONS=1"], \
+        ["-newton_ref_min", repr(float(segment["ref_min"]))]
 
 
 def watching(scene, state) -> bool:
@@ -113,6 +118,7 @@ def switch(scene, files, state, dimension: int, progress) -> None:
                            "ref_min": float(vtu.read_array(inc_dir / "dg_scale.txt")[0])})
     state.pending.insert(0, lf)
     state.reequilibrate = True
+    save(files, scene, state, dimension)
     progress(f"  increment {inc}: the opened faces cut the body into {rep_sep['bodies']} pieces: separated.msh, "
              f"remeshed ({rep['new_elements']} triangles, boundary 'opened'); going on with CG")
 
@@ -133,12 +139,13 @@ def cut_displacement(u_dg: np.ndarray, cells: np.ndarray, n_points: int) -> np.n
     return total / np.maximum(count, 1.0)[:, None]
 
 
-def history_extra(record: dict, segment: dict) -> dict:
-    """The CG rows' values of the DG columns of history.csv (see the module's docstring)."""
+def history_row(record: dict, extra: dict, segment: dict) -> dict:
+    """The history.csv row of an increment: its record and ``extra``; in a CG segment the DG columns hold the CG
+    support force and the cut (see the module's docstring)."""
     if segment.get("discretization") != CG:
-        return {}
-    extra = {"dg_open_faces": segment["opened"][0], "dg_open_length": segment["opened"][1]}
+        return {**record, **extra}
+    extra = {**extra, "dg_open_faces": segment["opened"][0], "dg_open_length": segment["opened"][1]}
     for a in "xy":
         if f"reaction_{a}" in record:
             extra[f"dg_reaction_{a}"] = record[f"reaction_{a}"]
-    return extra
+    return {**record, **extra}

@@ -211,8 +211,8 @@ def write_separated(mesh_path: Path, inc_dir: Path, out: Path) -> dict:
 def after_run(scene, files, state, progress) -> None:
     """A separating DG run: separated.msh, the mesh cut along the faces opened by the last increment."""
     dg = getattr(scene, "discretization", None)
-    if dg is None or dg.separation_stress <= 0 or not state.accepted:
-        return
+    if dg is None or dg.separation_stress <= 0 or not state.accepted or state.segments[-1].get("discretization"):
+        return          # (a run gone on with CG wrote it when it switched: wendel.loop.separated)
     inc = state.last[0]
     rep = write_separated(files.root / state.segment(inc)["mesh"], files.fem / f"inc-{inc:04d}",
                           files.root / "separated.msh")
