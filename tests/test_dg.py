@@ -67,6 +67,8 @@ def test_a_penalty_below_the_stability_bound_is_warned_about_and_spoils_the_solu
     (("gamma_mu = 20.0 ", "gamma_mu = -1.0 "), "discretization.gamma_mu"),
     (("kind = \"dg\"", "kind = \"hdg\""), "discretization.kind"),
     (("[numerics]", "[elasticity]\norder = 2\n\n[numerics]"), "elasticity.order = 1"),
+    (("kind = \"dg\"", "kind = \"dg\"\nafter_separation = \"cg\""), "after_separation = 'cg' needs separation_stress"),
+    (("kind = \"dg\"", "kind = \"cg\"\nafter_separation = \"cg\""), "after_separation needs discretization.kind"),
 ])
 def test_what_dg_does_not_join_is_refused_when_the_scene_is_read(scene_file, change, message):
     path = scene_file(edit((WORKFLOWS / "dg-mms.toml").read_text(), *change))

@@ -28,6 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..meshes import LABELS
 from ..results import separation, vtu
 from .checkpoint import save
 
@@ -94,20 +95,28 @@ def switch(scene, files, state, dimension: int, progress) -> None:
     inc_dir = files.fem / f"inc-{inc:04d}"
     rep_sep = separation.write_separated(files.root / state.segment(inc)["mesh"], inc_dir,
                                          files.root / "separated.msh")
-    # the increment on the cut mesh: each copy of a vertex gets the DG displacement of its own elements
+    # the pieces no Dirichlet boundary holds are left out (debris: no static equilibrium, the solve is singular)
     pseudo = files.root / "remesh" / "separated-increment"
     shutil.rmtree(pseudo, ignore_errors=True)
     pseudo.mkdir(parents=True)
-    _, cells = vtu.read_mesh(files.root / "separated.msh", 2)
-    n_points = len(vtu.read_mesh(files.root / "separated.msh", 2)[0])
-    vtu.write_array(pseudo / "u.node.txt", cut_displacement(vtu.read_array(inc_dir / "u_dg.qp.txt"), cells,
-                                                            n_points).ravel())
+    held = {LABELS[name] for name, b in scene.boundary.items() if any(v is not None for v in (b.ux, b.uy, b.uz))}
+    keep, used = separation.keep_held(files.root / "separated.msh", pseudo / "held.msh", held)
+    points, cells = vtu.read_mesh(files.root / "separated.msh", 2)
+    # the increment on the cut mesh: each copy of a vertex gets the DG displacement of its own elements
+    u = cut_displacement(vtu.read_array(inc_dir / "u_dg.qp.txt"), cells, len(points))
+    vtu.write_array(pseudo / "u.node.txt", u[used].ravel())
     for f in inc_dir.iterdir():
-        if f.name.endswith(".cell.txt") and not f.name.startswith("dg_") or f.name == "record.json":
-            shutil.copyfile(f, pseudo / f.name)
+        if f.name.endswith(".cell.txt") and not f.name.startswith("dg_"):
+            v = vtu.read_array(f)
+            vtu.write_array(pseudo / f.name, v.reshape(len(cells), -1)[keep])
+    shutil.copyfile(inc_dir / "record.json", pseudo / "record.json")
+    area = vtu_area(points, cells)
+    rep_sep.update({"dropped_pieces": int(rep_sep["bodies"] - len(np.unique(_bodies(cells)[keep]))),
+                    "dropped_area": float(area[~keep].sum())})
+    (files.root / "separated.json").write_text(json.dumps(rep_sep, indent=1))
     mesh_new, state_dir = "meshes/mesh-1.msh", "remesh/state-1"
     h = scene.geometry.h
-    rep = remesh_state(pseudo, files.root / "separated.msh", None, dimension, files.root / mesh_new,
+    rep = remesh_state(pseudo, pseudo / "held.msh", None, dimension, files.root / mesh_new,
                        files.root / state_dir, h, h / 3, "", mu=scene.material.E / (2 * (1 + scene.material.nu)),
                        deformed=False)
     rep.update({"remesh": 1, "after_increment": inc, "load_factor": lf, "relax_steps": 1, "separation": rep_sep})
@@ -119,8 +128,23 @@ def switch(scene, files, state, dimension: int, progress) -> None:
     state.pending.insert(0, lf)
     state.reequilibrate = True
     save(files, scene, state, dimension)
+    dropped = rep_sep["dropped_pieces"]
     progress(f"  increment {inc}: the opened faces cut the body into {rep_sep['bodies']} pieces: separated.msh, "
-             f"remeshed ({rep['new_elements']} triangles, boundary 'opened'); going on with CG")
+             f"remeshed ({rep['new_elements']} triangles, boundary 'opened'"
+             + (f"; {dropped} pieces no boundary condition holds left out, {rep_sep['dropped_area']:.3g} m^2" if dropped
+                else "") + "); going on with CG")
+
+
+def _bodies(cells):
+    from ..remesh.bodies import body_index
+
+    return body_index(cells)
+
+
+def vtu_area(points, cells):
+    p = np.asarray(points)[:, :2]
+    e1, e2 = p[cells[:, 1]] - p[cells[:, 0]], p[cells[:, 2]] - p[cells[:, 0]]
+    return 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
 
 
 def cut_displacement(u_dg: np.ndarray, cells: np.ndarray, n_points: int) -> np.ndarray:

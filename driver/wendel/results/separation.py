@@ -183,6 +183,26 @@ def reopen(mesh_path: Path):
     return new_points, new_tris
 
 
+def keep_held(mesh_path: Path, out: Path, held: set[int]) -> tuple[np.ndarray, np.ndarray]:
+    """``out``: the cut mesh of ``mesh_path`` without the bodies that touch no boundary labelled in ``held``
+    (a body that nothing holds has no static equilibrium); returns which triangles were kept and the old
+    numbers of the vertices kept, in their new order."""
+    points, tris, tri_tags, lines, line_tags, names = _read_tri_mesh(mesh_path)
+    _, _, _, body = cut(points, tris, set())
+    owner = {e: ts[0] for e, ts in _edges(tris).items()}
+    line_body = [body[owner[(min(a, b), max(a, b))]] for a, b in lines]
+    kept_bodies = {k for k, t in zip(line_body, line_tags) if t in held}
+    keep = np.isin(body, sorted(kept_bodies))
+    label = LABELS[OPENED]
+    used = np.unique(tris[keep])
+    new = np.full(len(points), -1)
+    new[used] = np.arange(len(used))
+    rest = [((new[a], new[b]), t) for (a, b), t, k in zip(lines, line_tags, line_body) if k in kept_bodies]
+    write_msh(out, points[used], new[tris[keep]], np.asarray(tri_tags)[keep], [e for e, t in rest if t != label],
+              [t for _, t in rest if t != label], [e for e, t in rest if t == label], names)
+    return keep, used
+
+
 def write_separated(mesh_path: Path, inc_dir: Path, out: Path) -> dict:
     """``out`` (MSH 2.2): the mesh of ``mesh_path`` cut along the faces opened by increment ``inc_dir``.
 
