@@ -80,3 +80,17 @@ def test_a_mesh_cut_along_opened_faces_is_remeshed_body_by_body_and_stays_cut(tm
         assert len(tip) == 1
         others = p[on][np.abs(p[on][:, 0] - 0.5) > 1e-9]
         assert len(others) == 2 * len(np.unique(others.round(12), axis=0))
+
+
+def test_the_pieces_no_boundary_condition_holds_are_left_out(tmp_path):
+    # cut across at y = 0.5 and around the cell [0.7, 0.8] x [0.7, 0.8] (an island of two triangles)
+    island = lambda v: [(v(7, 7), v(8, 7)), (v(8, 7), v(8, 8)), (v(8, 8), v(7, 8)), (v(7, 8), v(7, 7))]
+    path, points, nb = _cut_square(tmp_path, lambda v: [(v(i, 5), v(i + 1, 5)) for i in range(10)] + island(v))
+    assert nb == 3
+    keep, used = separation.keep_held(path, tmp_path / "held.msh", {3, 4})      # bottom and top hold
+    assert keep.sum() == 200 - 2 and len(used) == len(points) - 4
+    p, tris, seg = _opened(tmp_path / "held.msh")
+    assert bodies.body_index(tris).max() + 1 == 2 and len(p) == len(used)
+    assert len(seg) == 2 * 10 + 4           # both sides of the cut across, the island's outside only
+    info = mesher.remesh(p, tmp_path / "held.msh", tmp_path / "new.msh", 0.1)
+    assert info["bodies"] == 2 and info["measure_new"] == pytest.approx(0.99, rel=1e-12)

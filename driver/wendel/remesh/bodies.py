@@ -55,7 +55,8 @@ def glue(points, cells, facets, facet_tags, label):
     """Merge the copies of the vertices on the facets labelled ``label`` that share their reference position.
 
     Returns ``(rep, cut)``: the representative of every vertex (itself if not merged) and the cut edges
-    (sorted pairs of representatives, unique)."""
+    (sorted pairs of representatives, unique) that are interior edges once glued; the others (a side whose
+    other side is not in the mesh) stay boundary edges labelled ``label``."""
     rep = np.arange(len(points))
     on = np.unique(facets[facet_tags == label])
     if len(on) == 0:
@@ -63,7 +64,16 @@ def glue(points, cells, facets, facet_tags, label):
     _, first, inverse = np.unique(points[on, :2], axis=0, return_index=True, return_inverse=True)
     rep[on] = on[first[inverse.ravel()]]
     cut = np.unique(np.sort(rep[facets[facet_tags == label]], axis=1), axis=0)
-    return rep, cut
+    owners = _edge_count(rep[np.asarray(cells)])
+    return rep, cut[np.array([owners.get(tuple(e), 0) == 2 for e in cut.tolist()], dtype=bool).reshape(-1)]
+
+
+def _edge_count(cells):
+    count: dict[tuple[int, int], int] = {}
+    for tri in np.asarray(cells).tolist():
+        for a, b in ((tri[0], tri[1]), (tri[1], tri[2]), (tri[2], tri[0])):
+            count[(min(a, b), max(a, b))] = count.get((min(a, b), max(a, b)), 0) + 1
+    return count
 
 
 def model_2d(gmsh, pts, cells, edges, labels, feature_angle, groups, chains_2d, loops_of, cut=None, cut_label=0):

@@ -256,7 +256,9 @@ def remesh(points_deformed, mesh_in_path, out_path, h, size_indicator=None, h_mi
     cut = None
     if dim == 2 and OPENED in facet_tags:       # cut along opened faces: glued, meshed with the cut embedded
         rep, cut = bodies.glue(points0, cells, facets, facet_tags, OPENED)
-        keep = facet_tags != OPENED
+        inside = {tuple(e) for e in cut.tolist()}
+        keep = np.array([not (t == OPENED and tuple(sorted(f)) in inside)
+                         for f, t in zip(rep[facets].tolist(), facet_tags.tolist())], dtype=bool)
         facets, facet_tags, cells = rep[facets[keep]], facet_tags[keep], rep[cells]
         pts = _mean_of_copies(pts, rep)
         if np.any(quality.signed_measure(pts, cells) <= 0):
@@ -309,6 +311,8 @@ def remesh(points_deformed, mesh_in_path, out_path, h, size_indicator=None, h_mi
         etype = 2 if dim == 2 else 4
         _, conn = gmsh.model.mesh.getElementsByType(etype)
         new_cells = index[conn.astype(np.int64)].reshape(-1, dim + 1)
+        if len(new_cells) == 0:
+            raise ValueError(f"{mesh_in_path}: gmsh made no {_VOLUME[dim]}s from its boundary (see gmsh's log)")
         q = quality.mesh_quality(x, new_cells)
 
         gmsh.option.setNumber("Mesh.MshFileVersion", 2.2)
