@@ -6,7 +6,9 @@ label changes and at sharp corners (2D). The old physical tags (``meshes/labels.
 groups of the new mesh, which is written as MSH 2.2 (what FreeFEM's ``gmshload``/``gmshload3`` read).
 
 - 2D: the discrete curves get a piecewise-linear parametrization (``createGeometry``) and are meshed
-  again with the new size field; a plane surface is built on their curve loops. New boundary nodes lie
+  again with the new size field; a plane surface is built on the curve loops of each body
+  (:mod:`wendel.remesh.bodies`; a body cut along the boundary ``opened`` of a DG separation is glued,
+  meshed with the cut embedded and cut again there). New boundary nodes lie
   on the old (deformed) boundary polygon, so the domain is preserved exactly wherever the boundary is
   straight between corners, and to O(h^2 curvature) elsewhere.
 - 3D: the boundary triangulation is kept as it is (its nodes are the deformed old boundary nodes); the
