@@ -96,6 +96,9 @@ def append_history(root: Path, record: dict, newton_csv: Path) -> None:
     hist = root / "history.csv"
     keys = [k for k, v in record.items() if isinstance(v, (int, float))]
     new = not hist.exists() or hist.stat().st_size == 0   # created empty by a run stopped in this instant
+    if not new:      # the columns of the first row (a run that changes its modules, loop/separated.py, keeps them)
+        with open(hist, newline="") as f:
+            keys = next(csv.reader(f), keys)
     with open(hist, "a", newline="") as f:
         w = csv.DictWriter(f, fieldnames=keys, extrasaction="ignore")
         if new:
