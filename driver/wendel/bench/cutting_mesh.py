@@ -1,0 +1,147 @@
+"""``wendel bench cutting-mesh``: mesh and step convergence of the FE cut's forces (issue 17).
+
+The steel scene ``workflows/cutting-aisi1045.toml`` is cut with the graded remesh (``cutting.edge_size``,
+:func:`wendel.cutting.fe.size_zones`) at three edge resolutions, the edge radius r = 20 um over 1, 2 and 4
+(20, 10 and 5 um at the edge, the rest of the mesh the same), and once more at the middle resolution with half
+the increment (2.5 um, remeshed every twice as many increments: the same 40 um of travel between remeshes).
+Each cuts the scene's 600 um (4 h; ``STEPS``); ``--quick`` the first 100 um.
+
+A remeshed cut is a saw-tooth (the force drops in each re-equilibration and recovers over the cycle), so each
+case is measured on its **remesh-cycle means** (:func:`wendel.cutting.fe_steady.cycle_means`: the mean over the
+increments between two remeshes, re-equilibrations excluded): ``*_last`` is the mean of the last ``LAST``
+whole cycles (160 um of travel), ``*_spread`` the spread (max - min) / mean of those cycle means,
+``*_inc_spread`` that of the single increments in the same window. ``dFc_*`` compare the case with the finest
+edge at the same step and with the same edge at the other step: ``(F_c - F_c_ref) / F_c_ref``.
+
+Each case is written to ``results/bench/work/cutting-mesh/<case>/``; a case whose folder already holds the
+finished cut of the same scene (``cutting.csv`` and ``summary.json`` of that ``scene.resolved.json``) is read,
+not run again (the cases take 8-25 minutes each here): delete the folder to run it again.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+import time
+from pathlib import Path
+
+import numpy as np
+
+from . import WORKFLOWS, register
+
+LAST = 4         # cycles in the compared window
+STEPS = 120      # increments of 5 um: the scene's whole 600 um (4 h) cut
+CASES = [("r/1", 1, 1), ("r/2", 2, 1), ("r/4", 4, 1), ("r/2, half step", 2, 2)]
+"""(name, edge radius / edge size, increments per 5 um)."""
+
+
+def _scene(divide: int, substeps: int, quick: bool):
+    from ..scene import load
+    scene = load(WORKFLOWS / "cutting-aisi1045.toml")
+    c = scene.cutting
+    steps = 20 if quick else STEPS
+    c.cut_length *= steps / scene.loading.steps
+    scene.loading.steps = steps
+    c.edge_size = c.edge_radius / divide
+    scene.loading.steps *= substeps
+    c.remesh_every *= substeps
+    return scene
+
+
+def _finished(out: Path, scene) -> bool:
+    from ..cutting.fe import fe_scene
+    try:
+        old = json.loads((out / "scene.resolved.json").read_text())
+        new = json.loads(fe_scene(scene).model_dump_json())
+        done = json.loads((out / "summary.json").read_text()).get("increments", 0) > 0
+    except (OSError, ValueError):
+        return False
+    return done and (out / "cutting.csv").is_file() and _same(old, new)
+
+
+def _same(a, b) -> bool:
+    if isinstance(a, dict) and isinstance(b, dict):
+        return all(_same(a.get(k), b.get(k)) for k in set(a) & set(b))
+    if isinstance(a, (int, float)) and isinstance(b, (int, float)):
+        return abs(a - b) <= 1e-9 * max(abs(a), abs(b), 1e-30)
+    if isinstance(a, list) and isinstance(b, list):
+        return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b))
+    return a == b
+
+
+def measure(rows: list[dict]) -> dict:
+    """The window of the last ``LAST`` whole remesh cycles of a cut's ``cutting.csv`` rows (see the module)."""
+    from ..cutting.fe_steady import SERIES, cycle_means
+    cyc = cycle_means(rows)[-LAST:]
+    out = {"window_from_um": 0.0, "window_to_um": 0.0, "cycles": len(cyc)}
+    if not cyc:
+        return out
+    lo = min(r["tool_travel_m"] for r in cyc) - 20e-6
+    inc = [r for k, r in enumerate(rows) if r["tool_travel_m"] >= lo
+           and not (k and abs(r["tool_travel_m"] - rows[k - 1]["tool_travel_m"]) <= 1e-12)]
+    out["window_from_um"], out["window_to_um"] = inc[0]["tool_travel_m"] * 1e6, inc[-1]["tool_travel_m"] * 1e6
+    for key, name in zip(SERIES, ("Fc", "Ft", "chip")):
+        scale = 1e6 if key == "chip_thickness_m" else 1.0
+        v = np.array([r[key] for r in cyc], dtype=float)
+        w = np.array([r[key] for r in inc], dtype=float)
+        out[f"{name}_last"] = float(v.mean()) * scale
+        out[f"{name}_spread"] = float(np.ptp(v) / abs(v.mean())) if len(v) > 1 else float("nan")
+        out[f"{name}_inc_spread"] = float(np.ptp(w[np.isfinite(w)]) / abs(np.nanmean(w))) if len(w) > 1 else float("nan")
+    return out
+
+
+def _case(name: str, divide: int, substeps: int, quick: bool, workdir: Path) -> dict:
+    import csv
+
+    from ..cutting.fe_run import run_cut
+    from ..errors import StepCutError
+    from ..freefem import FreeFemError, NewtonFailure
+
+    scene = _scene(divide, substeps, quick)
+    out = workdir / name.replace("/", "").replace(", ", "-").replace(" ", "-")
+    stopped, wall = "", float("nan")
+    if _finished(out, scene):
+        wall = json.loads((out / "bench-case.json").read_text()).get("wall_s", wall) \
+            if (out / "bench-case.json").is_file() else wall
+    else:
+        shutil.rmtree(out, ignore_errors=True)
+        t0 = time.perf_counter()
+        try:
+            run_cut(scene, WORKFLOWS / "cutting-aisi1045.toml", out, smoke=False, progress=lambda *_: None,
+                    frames=False)
+        except (NewtonFailure, StepCutError, FreeFemError) as exc:
+            stopped = str(exc).split(";")[0]
+        wall = time.perf_counter() - t0
+        (out / "bench-case.json").write_text(json.dumps({"wall_s": wall, "stopped": stopped}))
+    if (out / "bench-case.json").is_file():
+        stopped = json.loads((out / "bench-case.json").read_text()).get("stopped", stopped)
+    rows = [{k: float(v) for k, v in r.items()} for r in csv.DictReader((out / "cutting.csv").open())]
+    s = json.loads((out / "summary.json").read_text())
+    remesh = sum(r.get("remesh_seconds", 0) + r.get("transfer_seconds", 0) for r in s["remeshes"])
+    c = scene.cutting
+    return {"case": name, "edge_size_um": c.edge_size * 1e6, "step_um": c.cut_length / scene.loading.steps * 1e6,
+            "travel_um": rows[-1]["tool_travel_m"] * 1e6, "increments": s["increments"],
+            "elements_max": int(max(r["elements"] for r in rows)), "remeshes": len(s["remeshes"]),
+            "newton_iterations": s["newton_iterations"], **measure(rows), "wall_s": wall,
+            "remesh_share": remesh / wall if wall == wall else float("nan"), "stopped": stopped}
+
+
+@register("cutting-mesh")
+def cutting_mesh_bench(quick: bool, workdir: Path) -> list[dict]:
+    """Three edge resolutions and two steps of the steel cut (see the module; 50-60 minutes, quick 10)."""
+    from ..cutting.scene import predict
+    workdir.mkdir(parents=True, exist_ok=True)
+    rows = []
+    for name, divide, substeps in CASES:
+        rows.append(_case(name, divide, substeps, quick, workdir))
+        (workdir / "partial.json").write_text(json.dumps(rows, indent=1))     # a long bench that stops keeps its cases
+    by = {(r["edge_size_um"], r["step_um"]): r for r in rows}
+    finest = min(r["edge_size_um"] for r in rows)
+    for r in rows:
+        ref = by.get((finest, r["step_um"]))
+        r["dFc_vs_finest_edge"] = (r["Fc_last"] - ref["Fc_last"]) / ref["Fc_last"] if ref else float("nan")
+        other = [o for o in rows if o["edge_size_um"] == r["edge_size_um"] and o["step_um"] != r["step_um"]]
+        r["dFc_vs_other_step"] = (r["Fc_last"] - other[0]["Fc_last"]) / other[0]["Fc_last"] if other else float("nan")
+    ox = predict(_scene(1, 1, quick))
+    rows.append({"case": "Oxley (sharp tool)", "Fc_last": ox.Fc, "Ft_last": ox.Ft, "chip_last": ox.chip_thickness * 1e6})
+    return rows
