@@ -149,7 +149,7 @@ def fe_scene(scene, travel: float = 1.0) -> Scene:
         "material": {"E": scene.material.E * MPA, "nu": scene.material.nu},
         "elasticity": {"plane": "strain"},
         "plasticity": plasticity,
-        "kinematics": {"kind": "updated-lagrangian"},
+        "kinematics": {"kind": "updated-lagrangian", "volumetric": c.volumetric},
         "boundary": boundary,
         "contact": {"boundary": "free_surface", "normal": "+y", "obstacle": "tool",
                     "tool": {"vertices": tool["vertices"], "radii": tool["radii"]}, "friction": friction,

@@ -18,7 +18,7 @@ isothermal prototype, :data:`FE_READY`).
 
 from __future__ import annotations
 
-from typing import Optional
+from typing import Literal, Optional
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
@@ -77,6 +77,9 @@ class Cutting(BaseModel):
                                        "edge [m], graded to geometry.fine * geometry.h around the primary shear "
                                        "zone and the rake contact and to twice that elsewhere "
                                        "(wendel.cutting.fe.size_zones); default: uniform geometry.fine * geometry.h")
+    volumetric: Literal["cell", "fbar"] = Field("cell", description="FE: the updated-Lagrangian volume change, "
+                                                "per cell (P1, locks in the isochoric plastic flow) or F-bar "
+                                                "(kinematics.volumetric)")
     oxley: OxleyConstants = OxleyConstants()
 
     @model_validator(mode="after")
