@@ -2,8 +2,8 @@
 
 The steel scene ``workflows/cutting-aisi1045.toml`` is cut with the graded remesh (``cutting.edge_size``,
 :func:`wendel.cutting.fe.size_zones`) at three edge resolutions, the edge radius r = 20 um over 1, 2 and 4
-(20, 10 and 5 um at the edge, the rest of the mesh the same), and once more at the middle resolution with half
-the increment (2.5 um, remeshed every twice as many increments: the same 40 um of travel between remeshes).
+(20, 10 and 5 um at the edge, the rest of the mesh the same), and once more at the coarsest resolution (the
+cheapest) with half the increment (2.5 um, remeshed every twice as many increments: the same 40 um of travel between remeshes).
 Each cuts the scene's 600 um (4 h; ``STEPS``); ``--quick`` the first 100 um.
 
 A remeshed cut is a saw-tooth (the force drops in each re-equilibration and recovers over the cycle), so each
@@ -12,6 +12,9 @@ increments between two remeshes, re-equilibrations excluded): ``*_last`` is the 
 whole cycles (160 um of travel), ``*_spread`` the spread (max - min) / mean of those cycle means,
 ``*_inc_spread`` that of the single increments in the same window. ``dFc_*`` compare the case with the finest
 edge at the same step and with the same edge at the other step: ``(F_c - F_c_ref) / F_c_ref``.
+
+``wendel bench cutting-fbar``: the middle resolution with F-bar (``cutting.volumetric = "fbar"``), against
+the same case without it.
 
 Each case is written to ``results/bench/work/cutting-mesh/<case>/``; a case whose folder already holds the
 finished cut of the same scene (``cutting.csv`` and ``summary.json`` of that ``scene.resolved.json``) is read,
@@ -31,14 +34,15 @@ from . import WORKFLOWS, register
 
 LAST = 4         # cycles in the compared window
 STEPS = 120      # increments of 5 um: the scene's whole 600 um (4 h) cut
-CASES = [("r/1", 1, 1), ("r/2", 2, 1), ("r/4", 4, 1), ("r/2, half step", 2, 2)]
+CASES = [("r/2", 2, 1), ("r/4", 4, 1), ("r/1", 1, 1), ("r/1, half step", 1, 2)]
 """(name, edge radius / edge size, increments per 5 um)."""
 
 
-def _scene(divide: int, substeps: int, quick: bool):
+def _scene(divide: int, substeps: int, quick: bool, volumetric: str = "cell"):
     from ..scene import load
     scene = load(WORKFLOWS / "cutting-aisi1045.toml")
     c = scene.cutting
+    c.volumetric = volumetric
     steps = 20 if quick else STEPS
     c.cut_length *= steps / scene.loading.steps
     scene.loading.steps = steps
@@ -90,14 +94,14 @@ def measure(rows: list[dict]) -> dict:
     return out
 
 
-def _case(name: str, divide: int, substeps: int, quick: bool, workdir: Path) -> dict:
+def _case(name: str, divide: int, substeps: int, quick: bool, workdir: Path, volumetric: str = "cell") -> dict:
     import csv
 
     from ..cutting.fe_run import run_cut
     from ..errors import StepCutError
     from ..freefem import FreeFemError, NewtonFailure
 
-    scene = _scene(divide, substeps, quick)
+    scene = _scene(divide, substeps, quick, volumetric)
     out = workdir / name.replace("/", "").replace(", ", "-").replace(" ", "-")
     stopped, wall = "", float("nan")
     if _finished(out, scene):
@@ -119,7 +123,7 @@ def _case(name: str, divide: int, substeps: int, quick: bool, workdir: Path) -> 
     s = json.loads((out / "summary.json").read_text())
     remesh = sum(r.get("remesh_seconds", 0) + r.get("transfer_seconds", 0) for r in s["remeshes"])
     c = scene.cutting
-    return {"case": name, "edge_size_um": c.edge_size * 1e6, "step_um": c.cut_length / scene.loading.steps * 1e6,
+    return {"case": name, "volumetric": volumetric, "edge_size_um": c.edge_size * 1e6, "step_um": c.cut_length / scene.loading.steps * 1e6,
             "travel_um": rows[-1]["tool_travel_m"] * 1e6, "increments": s["increments"],
             "elements_max": int(max(r["elements"] for r in rows)), "remeshes": len(s["remeshes"]),
             "newton_iterations": s["newton_iterations"], **measure(rows), "wall_s": wall,
@@ -144,4 +148,15 @@ def cutting_mesh_bench(quick: bool, workdir: Path) -> list[dict]:
         r["dFc_vs_other_step"] = (r["Fc_last"] - other[0]["Fc_last"]) / other[0]["Fc_last"] if other else float("nan")
     ox = predict(_scene(1, 1, quick))
     rows.append({"case": "Oxley (sharp tool)", "Fc_last": ox.Fc, "Ft_last": ox.Ft, "chip_last": ox.chip_thickness * 1e6})
+    return rows
+
+
+@register("cutting-fbar")
+def cutting_fbar_bench(quick: bool, workdir: Path) -> list[dict]:
+    """The middle resolution of ``cutting-mesh`` (edge r/2) with F-bar (``cutting.volumetric = "fbar"``) beside
+    the same case without it (read from ``cutting-mesh``'s folder when that bench has run it, else run)."""
+    workdir.mkdir(parents=True, exist_ok=True)
+    rows = [_case("r/2", 2, 1, quick, workdir.parent / "cutting-mesh"),
+            _case("r/2, F-bar", 2, 1, quick, workdir, "fbar")]
+    rows[1]["dFc_vs_cell"] = (rows[1]["Fc_last"] - rows[0]["Fc_last"]) / rows[0]["Fc_last"]
     return rows
