@@ -124,7 +124,9 @@ def fe_scene(scene, travel: float = 1.0) -> Scene:
     every = c.remesh_every
     # the re-equilibration after a remesh is an increment too: the k-th remesh follows increment k (every + 1) - 1
     # (a step cut shifts the later ones by one increment)
-    at = [k * (every + 1) - 1 for k in range(1, (steps - 1) // every + 1)] if every else []
+    # (a step cut shifts the later ones by one increment, and adds one: the list runs on to 3 times the steps, or
+    # a cut with many step cuts ran out of scheduled remeshes at 70 % of its travel, measured at edge size r/4)
+    at = [k * (every + 1) - 1 for k in range(1, 3 * steps // every + 1)] if every else []
     # uniform size fine * h (graded on p down to half of it at the edge, the isothermal cut stopped at 40 um
     # instead of 92.5, measured: "mesh would invert" after the second remesh)
     remesh = {"at": at, "indicator": "", "h": fine * g.h * MM, "max_remeshes": len(at) + 20,
