@@ -89,15 +89,30 @@ def steady(rows: list[dict], length: float, tol: float = 0.02) -> dict:
     Also the spreads of the last window of that length, so that a cut that does not settle says how far off it is."""
     inc = [r for k, r in enumerate(rows) if not (k and abs(r["tool_travel_m"] - rows[k - 1]["tool_travel_m"]) <= 1e-12)]
     cyc = cycle_means(rows)
-    last = {}
+    last, trend = {}, {}
     for name, rr in (("raw", inc), ("cycles", cyc)):
         if rr:
             end = rr[-1]["tool_travel_m"]
             w = [r for r in rr if r["tool_travel_m"] >= end - length * (1 + 1e-9)]
+            ok = {k: len(w) > 1 and all(np.isfinite(r[k]) for r in w) for k in SERIES}
             last[name] = {k: (float(np.ptp([r[k] for r in w])) / abs(float(np.mean([r[k] for r in w])))
-                              if len(w) > 1 and all(np.isfinite(r[k]) for r in w) else None) for k in SERIES}
+                              if ok[k] else None) for k in SERIES}
+            trend[name] = {k: _trend(w, k, length) if ok[k] else None for k in SERIES}
     return {"length_m": length, "tol": tol, "raw": _detect(inc, length, tol), "cycles": _detect(cyc, length, tol),
-            "cycle_means": cyc, "last_window_spreads": last}
+            "cycle_means": cyc, "last_window_spreads": last, "last_window_trends": trend}
+
+
+def _trend(rows: list[dict], key: str, length: float) -> float:
+    """The change over ``length`` of travel of a least-squares line through the window, over its mean: the part
+    of a spread that is a drift (a cut still settling) rather than a scatter.
+
+    >>> round(_trend([{"tool_travel_m": t, "Fc_N": 99.0 + 2 * t} for t in (0.0, 0.5, 1.0)], "Fc_N", 1.0), 9)
+    0.02
+    """
+    x = np.array([r["tool_travel_m"] for r in rows])
+    v = np.array([r[key] for r in rows], dtype=float)
+    slope = np.polyfit(x, v, 1)[0] if np.ptp(x) > 0 else 0.0
+    return float(slope * length / abs(v.mean()))
 
 
 def gif(frames: Path, out: Path, every: int = 1, ms: int = 200) -> Path | None:
