@@ -14,7 +14,8 @@ whole cycles (160 um of travel), ``*_spread`` the spread (max - min) / mean of t
 ``*_inc_spread`` that of the single increments in the same window. ``dFc_*`` compare the case with the finest
 edge at the same step and with the same edge at the other step: ``(F_c - F_c_ref) / F_c_ref``.
 
-``wendel bench cutting-fbar``: the middle resolution with F-bar (``cutting.volumetric = "fbar"``), against
+``wendel bench cutting-steady``: the middle resolution cut 1.2 mm, twice the scene's length, on a longer block:
+the remesh-cycle means and whether they settle. ``wendel bench cutting-fbar``: the middle resolution with F-bar (``cutting.volumetric = "fbar"``), against
 the same case without it.
 
 Each case is written to ``results/bench/work/cutting-mesh/<case>/``; a case whose folder already holds the
@@ -161,3 +162,44 @@ def cutting_fbar_bench(quick: bool, workdir: Path) -> list[dict]:
             _case("r/2, F-bar", 2, 1, quick, workdir, "fbar")]
     rows[1]["dFc_vs_cell"] = (rows[1]["Fc_last"] - rows[0]["Fc_last"]) / rows[0]["Fc_last"]
     return rows
+
+
+@register("cutting-steady")
+def cutting_steady_bench(quick: bool, workdir: Path) -> list[dict]:
+    """The middle resolution (edge r/2) cut twice as far as the scene, 1.2 mm (8 h), on a block 2.6 mm long
+    (the primary zone stays clear of its far end): whether and where the forces and the chip settle within 2 %
+    (:func:`wendel.cutting.fe_steady.steady` on the remesh-cycle means, a window of one h), with the last
+    window's spreads and drifts. ``--quick``: 400 um."""
+    import csv
+
+    from ..cutting.fe_steady import steady
+    scene = _scene(2, 1, quick=False)
+    length = 0.4e-3 if quick else 1.2e-3
+    scene.geometry.model_extra["length"] = 2.6e-3
+    scene.cutting.cut_length = length
+    scene.loading.steps = round(length / 5e-6)
+    out = workdir / "r2-long"
+    shutil.rmtree(out, ignore_errors=True)
+    from ..cutting.fe_run import run_cut
+    from ..errors import StepCutError
+    from ..freefem import FreeFemError, NewtonFailure
+    stopped = ""
+    t0 = time.perf_counter()
+    try:
+        run_cut(scene, WORKFLOWS / "cutting-aisi1045.toml", out, smoke=False, progress=lambda *_: None, frames=True)
+    except (NewtonFailure, StepCutError, FreeFemError) as exc:
+        stopped = str(exc).split(";")[0]
+    wall = time.perf_counter() - t0
+    rows = [{k: float(v) for k, v in r.items()} for r in csv.DictReader((out / "cutting.csv").open())]
+    st = steady(rows, scene.cutting.uncut_thickness)
+    res = []
+    for c in st["cycle_means"]:
+        res.append({"travel_um": c["tool_travel_m"] * 1e6, "Fc_N": c["Fc_N"], "Ft_N": c["Ft_N"],
+                    "chip_um": c["chip_thickness_m"] * 1e6})
+    found = st["cycles"]
+    res.append({"travel_um": rows[-1]["tool_travel_m"] * 1e6, "steady_from_um": found["start_m"] * 1e6 if found else None,
+                **{f"spread_{k}": v for k, v in st["last_window_spreads"]["cycles"].items()},
+                **{f"drift_{k}": v for k, v in st["last_window_trends"]["cycles"].items()},
+                **{f"inc_spread_{k}": v for k, v in st["last_window_spreads"]["raw"].items()},
+                "wall_s": wall, "stopped": stopped})
+    return res
