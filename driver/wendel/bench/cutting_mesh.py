@@ -8,10 +8,10 @@ Each cuts the first 400 um (2.7 h) of the scene's 600 um (``STEPS``: the whole c
 here); ``--quick`` the first 100 um.
 
 A remeshed cut is a saw-tooth (the force drops in each re-equilibration and recovers over the cycle), so each
-case is measured on its **remesh-cycle means** (:func:`wendel.cutting.fe_steady.cycle_means`: the mean over the
-increments between two remeshes, re-equilibrations excluded): ``*_last`` is the mean of the last ``LAST``
-whole cycles (160 um of travel), ``*_spread`` the spread (max - min) / mean of those cycle means,
-``*_inc_spread`` that of the single increments in the same window. ``dFc_*`` compare the case with the finest
+case is measured over the same **window of travel**, the last ``WINDOW`` (160 um, 4 remesh cycles): ``*_last``
+is the mean over its increments weighted by the travel each covers (re-equilibrations excluded: for a force,
+the work over the travel), ``*_spread`` the spread (max - min) / mean of the remesh-cycle means
+(:func:`wendel.cutting.fe_steady.cycle_means`) inside it, ``*_inc_spread`` that of the single increments. ``dFc_*`` compare the case with the finest
 edge at the same step and with the same edge at the other step: ``(F_c - F_c_ref) / F_c_ref``.
 
 ``wendel bench cutting-steady``: the middle resolution cut 1.2 mm, twice the scene's length, on a longer block:
@@ -34,7 +34,7 @@ import numpy as np
 
 from . import WORKFLOWS, register
 
-LAST = 4         # cycles in the compared window
+WINDOW = 160e-6  # m: the compared window, the last 160 um of travel (4 remesh cycles of 40 um without step cuts)
 STEPS = 80       # increments of 5 um: the first 400 um (2.7 h) of the scene's 600 um cut
 CASES = [("r/2", 2, 1), ("r/4", 4, 1), ("r/3", 3, 1), ("r/2, half step", 2, 2)]
 """(name, edge radius / edge size, increments per 5 um)."""
@@ -75,24 +75,24 @@ def _same(a, b) -> bool:
     return a == b
 
 
-def measure(rows: list[dict]) -> dict:
-    """The window of the last ``LAST`` whole remesh cycles of a cut's ``cutting.csv`` rows (see the module)."""
+def measure(rows: list[dict], window: float = WINDOW) -> dict:
+    """The last ``window`` [m] of travel of a cut's ``cutting.csv`` rows (see the module)."""
     from ..cutting.fe_steady import SERIES, cycle_means
-    cyc = cycle_means(rows)[-LAST:]
-    out = {"window_from_um": 0.0, "window_to_um": 0.0, "cycles": len(cyc)}
-    if not cyc:
-        return out
-    lo = min(r["tool_travel_m"] for r in cyc) - 20e-6
-    inc = [r for k, r in enumerate(rows) if r["tool_travel_m"] >= lo
-           and not (k and abs(r["tool_travel_m"] - rows[k - 1]["tool_travel_m"]) <= 1e-12)]
-    out["window_from_um"], out["window_to_um"] = inc[0]["tool_travel_m"] * 1e6, inc[-1]["tool_travel_m"] * 1e6
+    t = np.array([r["tool_travel_m"] for r in rows])
+    hi = t[-1]
+    lo = hi - window
+    w = np.diff(t, prepend=0.0)                     # the travel each row covers (0 for a re-equilibration)
+    inc = (t > lo + 1e-12) & (w > 1e-12)
+    cyc = [c for c in cycle_means(rows) if c["tool_travel_m"] > lo]
+    out = {"window_from_um": float(lo) * 1e6, "window_to_um": float(hi) * 1e6, "cycles": len(cyc)}
     for key, name in zip(SERIES, ("Fc", "Ft", "chip")):
         scale = 1e6 if key == "chip_thickness_m" else 1.0
-        v = np.array([r[key] for r in cyc], dtype=float)
-        w = np.array([r[key] for r in inc], dtype=float)
-        out[f"{name}_last"] = float(v.mean()) * scale
-        out[f"{name}_spread"] = float(np.ptp(v) / abs(v.mean())) if len(v) > 1 else float("nan")
-        out[f"{name}_inc_spread"] = float(np.ptp(w[np.isfinite(w)]) / abs(np.nanmean(w))) if len(w) > 1 else float("nan")
+        v = np.array([r[key] for r in rows], dtype=float)
+        ok = inc & np.isfinite(v)
+        c = np.array([r[key] for r in cyc], dtype=float)
+        out[f"{name}_last"] = float(np.average(v[ok], weights=w[ok])) * scale if ok.any() else float("nan")
+        out[f"{name}_spread"] = float(np.ptp(c) / abs(c.mean())) if len(c) > 1 else float("nan")
+        out[f"{name}_inc_spread"] = float(np.ptp(v[ok]) / abs(v[ok].mean())) if ok.sum() > 1 else float("nan")
     return out
 
 
