@@ -216,7 +216,7 @@ def _zone_field(gmsh, zone, h):
 
 
 def remesh(points_deformed, mesh_in_path, out_path, h, size_indicator=None, h_min=None,
-           feature_angle=30.0, optimize=True, algorithm_3d=10, zones=None):
+           feature_angle=30.0, optimize=True, algorithm_3d=10, zones=None, algorithm_2d=None):
     """Mesh the deformed body anew from its boundary; write MSH 2.2 with the same labels.
 
     Parameters
@@ -245,6 +245,8 @@ def remesh(points_deformed, mesh_in_path, out_path, h, size_indicator=None, h_mi
         3D: Netgen optimization of the tetrahedra (min SICN ~0.3 instead of ~0.005 for raw HXT output).
     algorithm_3d : int
         gmsh ``Mesh.Algorithm3D`` (10 = HXT, 1 = Delaunay).
+    algorithm_2d : int, optional
+        gmsh ``Mesh.Algorithm`` (default gmsh's 6 = Frontal-Delaunay; 5 = Delaunay, 1 = MeshAdapt).
 
     Returns
     -------
@@ -320,6 +322,8 @@ def remesh(points_deformed, mesh_in_path, out_path, h, size_indicator=None, h_mi
             gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
             gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
             gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
+        if dim == 2 and algorithm_2d is not None:
+            gmsh.option.setNumber("Mesh.Algorithm", algorithm_2d)
         if dim == 3:
             gmsh.option.setNumber("Mesh.Algorithm3D", algorithm_3d)
             gmsh.option.setNumber("Mesh.OptimizeNetgen", 1 if optimize else 0)

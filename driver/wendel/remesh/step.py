@@ -31,6 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .again import AGAIN
 from . import quality       # mesher (meshio, gmsh) and transfer (scipy) when a run remeshes: a run without
                             # remeshing judges its mesh only and does not pay their imports
 from ..results import vtu
@@ -86,7 +87,7 @@ def yield_violation(eps0: np.ndarray, epsp: np.ndarray, sigma_y: np.ndarray, mu:
 def remesh_state(inc_dir: Path, mesh_old: Path, ubase_old: np.ndarray | None, dimension: int,
                  mesh_new: Path, state_new: Path, h: float, h_min: float, indicator: str,
                  mu: float | None = None, axisymmetric: bool = False, make_mesh=None,
-                 deformed: bool = True, zones: list[dict] | None = None) -> dict:
+                 deformed: bool = True, zones: list[dict] | None = None, algorithm_2d: int | None = None) -> dict:
     """Mesh the deformed body of increment ``inc_dir`` anew and write the transferred state.
 
     Writes ``mesh_new`` and, in ``state_new``, ``u.node.txt`` (zeros), ``ubase.txt``, ``eps0.txt`` and the
@@ -113,7 +114,8 @@ def remesh_state(inc_dir: Path, mesh_old: Path, ubase_old: np.ndarray | None, di
         size_ind = transfer.cell_to_nodes(xd, cells, cellfield(indicator)[:, 0], axisymmetric=axisymmetric)
     with _quiet_stdout():
         info = (make_mesh or mesher.remesh)(xd, mesh_old, mesh_new, h, size_indicator=size_ind, h_min=h_min,
-                                            **({"zones": zones} if zones else {}))
+                                            **({"zones": zones} if zones else {}),
+                                            **({"algorithm_2d": algorithm_2d} if algorithm_2d is not None else {}))
     t1 = time.perf_counter()
     Y, new_cells = vtu.read_mesh(mesh_new, dimension)
     Y = Y[:, :dimension]
@@ -243,7 +245,7 @@ def zones_at(r, inc_dir: Path) -> list[dict]:
             for z in r.zones]
 
 
-def maybe_remesh(scene, files, state, dimension: int, progress) -> None:
+def maybe_remesh(scene, files, state, dimension: int, progress, again: int = 0) -> None:
     """The loop's remesh step: after the last accepted increment, remesh when its deformed mesh is too poor
     (or the scene asks); the next launch re-equilibrates the transferred state at the same load factor.
 
@@ -274,8 +276,10 @@ def maybe_remesh(scene, files, state, dimension: int, progress) -> None:
                                  files.root / mesh_new, files.root / state_dir, h, r.h_min or h / 3, r.indicator,
                                  mu=scene.material.E / (2 * (1 + scene.material.nu)),
                                  axisymmetric=scene.elasticity.plane == "axisymmetric",
-                                 zones=zones_at(r, files.fem / f"inc-{inc:04d}"))
-    rep.update({"remesh": k, "after_increment": inc, "load_factor": lf})
+                                 zones=zones_at(r, files.fem / f"inc-{inc:04d}"),
+                                 algorithm_2d=AGAIN[again - 1] if again else None)
+    rep.update({"remesh": k, "after_increment": inc, "load_factor": lf, "dimension": dimension,
+                "algorithm_2d_tries": again})
     state.remeshes.append(rep)
     state.segments.append({"first": inc + 1, "mesh": mesh_new, "ubase": f"{state_dir}/ubase.txt",
                            "eps0": f"{state_dir}/eps0.txt", "state": state_dir})
