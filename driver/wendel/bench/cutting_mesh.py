@@ -156,9 +156,9 @@ def cutting_mesh_bench(quick: bool, workdir: Path) -> list[dict]:
 @register("cutting-fbar")
 def cutting_fbar_bench(quick: bool, workdir: Path) -> list[dict]:
     """The middle resolution of ``cutting-mesh`` (edge r/2) with F-bar (``cutting.volumetric = "fbar"``) beside
-    the same case without it (read from ``cutting-mesh``'s folder when that bench has run it, else run)."""
+    the same case without it (each in this bench's own folder)."""
     workdir.mkdir(parents=True, exist_ok=True)
-    rows = [_case("r/2", 2, 1, quick, workdir.parent / "cutting-mesh"),
+    rows = [_case("r/2", 2, 1, quick, workdir),
             _case("r/2, F-bar", 2, 1, quick, workdir, "fbar")]
     rows[1]["dFc_vs_cell"] = (rows[1]["Fc_last"] - rows[0]["Fc_last"]) / rows[0]["Fc_last"]
     return rows
