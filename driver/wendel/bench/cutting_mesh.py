@@ -96,6 +96,26 @@ def measure(rows: list[dict], window: float = WINDOW) -> dict:
     return out
 
 
+def sawtooth(out: Path) -> dict:
+    """What each re-equilibration of the run in ``out`` does: the change of F_c over it (relative, the least
+    and the most) and the cells' mean stress extremes [MPa] before it (the end of a cycle) and after it (the
+    transferred state re-equilibrated), from ``history.csv``: the checkerboard of the P1 pressure and its reset."""
+    import csv
+    rows = list(csv.DictReader((out / "history.csv").open()))
+    drop, before, after = [], [], []
+    for k, r in enumerate(rows):
+        if k and r.get("reequilibration") == "1":
+            a = rows[k - 1]
+            drop.append(float(r["contact_force_x"]) / float(a["contact_force_x"]) - 1)
+            before.append(max(-float(a["mean_stress_min"]), float(a["mean_stress_max"])))
+            after.append(max(-float(r["mean_stress_min"]), float(r["mean_stress_max"])))
+    if not drop:
+        return {}
+    return {"reeq_dFc_min": min(drop), "reeq_dFc_max": max(drop), "mean_stress_abs_before_min": min(before),
+            "mean_stress_abs_before_max": max(before), "mean_stress_abs_after_min": min(after),
+            "mean_stress_abs_after_max": max(after)}
+
+
 def _case(name: str, divide: int, substeps: int, quick: bool, workdir: Path, volumetric: str = "cell") -> dict:
     import csv
 
@@ -128,7 +148,7 @@ def _case(name: str, divide: int, substeps: int, quick: bool, workdir: Path, vol
     return {"case": name, "volumetric": volumetric, "edge_size_um": c.edge_size * 1e6, "step_um": c.cut_length / scene.loading.steps * 1e6,
             "travel_um": rows[-1]["tool_travel_m"] * 1e6, "increments": s["increments"],
             "elements_max": int(max(r["elements"] for r in rows)), "remeshes": len(s["remeshes"]),
-            "newton_iterations": s["newton_iterations"], **measure(rows), "wall_s": wall,
+            "newton_iterations": s["newton_iterations"], **measure(rows), **sawtooth(out), "wall_s": wall,
             "remesh_share": remesh / wall if wall == wall else float("nan"), "stopped": stopped}
 
 
