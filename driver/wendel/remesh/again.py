@@ -17,7 +17,7 @@ def remesh_again(scene, files, state, progress) -> bool:
     every algorithm has been tried (or in 3D)."""
     rep = state.remeshes[-1]
     tried = rep.get("algorithm_2d_tries", 0)
-    if rep.get("dimension", 2) != 2 or tried >= len(AGAIN):
+    if rep.get("dimension") != 2 or tried >= len(AGAIN):
         return False
     state.remeshes.pop()
     state.segments.pop()
