@@ -34,11 +34,12 @@ from .labels import LABELS
 
 @register("orthogonal-cutting", ["left", "bottom", "right", "machined", "free_surface", "layer_end"])
 def orthogonal_cutting(path: Path, length=2e-3, depth=1e-3, uncut=0.15e-3, pre_cut=0.3e-3, band=2.0,
-                       fine=0.25, h=1e-4) -> Built:
+                       fine=0.25, h=1e-4, refine=None) -> Built:
     """Workpiece of an orthogonal cut (lengths in m): ``length`` along the cut, ``depth`` below the
     machined level, the cut layer ``uncut`` thick, a machined step ``pre_cut`` long at the right end;
     size ``h``, and ``fine * h`` in the band from ``band * uncut`` below the machined level to the top of
-    the cut layer."""
+    the cut layer; ``refine`` (a zone of the builders, e.g. around the tool's edge at the step face) finer
+    still where it asks a smaller size."""
     h_fine, band = fine * h, band * uncut
     if not (0 < pre_cut < length and 0 < uncut and 0 < depth and 0 < band <= depth and 0 < fine <= 1):
         raise ValueError("orthogonal-cutting needs 0 < pre_cut < length, uncut > 0, 0 < band * uncut <= depth "
@@ -60,5 +61,16 @@ def orthogonal_cutting(path: Path, length=2e-3, depth=1e-3, uncut=0.15e-3, pre_c
             gmsh.model.addPhysicalGroup(1, tags, LABELS[name], name)
         gmsh.model.addPhysicalGroup(2, [surface], LABELS["domain"], "domain")
         # the refined band along the tool path: a block zone of the builders' size field
-        _size_field(gmsh, h, {"box": [[-h, -band], [length + h, uncut + h]], "h": h_fine, "thickness": band})
+        band_zone = {"box": [[-h, -band], [length + h, uncut + h]], "h": h_fine, "thickness": band}
+        if not refine:
+            _size_field(gmsh, h, band_zone)
+        else:       # the smaller of the band's and the zone's sizes (the builders' size field, each on its own)
+            f = gmsh.model.mesh.field
+            fields = []
+            for zone in (band_zone, refine):
+                _size_field(gmsh, h, zone)
+                fields.append(max(f.list()))
+            both = f.add("Min")
+            f.setNumbers(both, "FieldsList", fields)
+            f.setAsBackgroundMesh(both)
         return _write(gmsh, path, 2, list(groups))

@@ -16,7 +16,8 @@ of modules that exist and are tested on their own:
   left out, and so is the frictional heat, which has no heat equation to enter). Other couplings: the cut
   is isothermal (at T_room; conduction with UL is not written);
 - a remesh of the deformed body every ``cutting.remesh_every`` increments (and whenever the element
-  quality falls below 0.1), uniform size ``geometry.fine * geometry.h``, with transfer of the UL state
+  quality falls below 0.1), uniform size ``geometry.fine * geometry.h`` or, with ``cutting.edge_size``,
+  graded from that size at the edge (:func:`size_zones`), with transfer of the UL state
   (``ul_eps``) and the plastic state (``wendel.remesh``).
 
 **Units.** The FE scene is written in mm, MPa, N, s and K (forces per unit width in N/mm, energy mJ, so
@@ -49,6 +50,9 @@ MM = 1e3          # m -> mm
 MPA = 1e-6        # Pa -> MPa
 GAP = 0.02        # the tool starts this fraction of h in front of the step face
 RELAX_STEPS = 4   # the re-equilibration after a remesh releases the transferred out-of-balance in 4 stages
+EDGE_ZONE = 2.0   # graded remesh (cutting.edge_size): the edge box reaches 2 edge radii from the edge's centre
+GROWTH = 0.3      # ... the size grows by 0.3 per unit distance outside a zone
+FAR = 2.0         # ... and is 2 geometry.fine * geometry.h far from the tool
 
 
 def tool_at_start(cutting, x_step: float) -> dict:
@@ -74,6 +78,22 @@ def tool_at_start(cutting, x_step: float) -> dict:
     tip = (centre + shift - [0.0, r]) if r > 0 else shift
     return {"vertices": (sharp + shift).tolist(), "radii": radii, "tip": tip.tolist(),
             "rake_dir": t_rake.tolist(), "edge": (shift + [0.0, 0.0]).tolist()}
+
+
+def size_zones(cutting, tip, h_mid: float, travel: float) -> list[dict]:
+    """The remeshes' size zones [mm] for the tool at load factor 0 (they follow the tool): ``cutting.edge_size``
+    in a box around the edge (half-width ``EDGE_ZONE`` edge radii, at least 4 edge sizes), ``h_mid`` in a box
+    over the primary shear zone, the chip root and the rake contact (3 h ahead of the edge to 2 h behind it,
+    h below to 3.5 h above the tip), each reaching ahead by the ``travel`` until the next remesh (the tool
+    must still be in them then), each graded by ``GROWTH`` (size per unit distance) to the size outside it
+    (``FAR`` h_mid far away). Written for the tool at the tip ``tip`` [mm]."""
+    h, r, s = cutting.uncut_thickness * MM, cutting.edge_radius * MM, cutting.edge_size * MM
+    x, y = tip
+    a = max(EDGE_ZONE * r, 4 * s)
+    cy = y + r
+    return [{"box": [[x - a - travel, cy - a], [x + a, cy + a]], "h": s, "thickness": max(h_mid - s, 0.0) / GROWTH},
+            {"box": [[x - 3 * h - travel, y - h], [x + 2 * h, y + 3.5 * h]], "h": h_mid,
+             "thickness": (FAR - 1) * h_mid / GROWTH}]
 
 
 def fe_scene(scene, travel: float = 1.0) -> Scene:
@@ -104,11 +124,20 @@ def fe_scene(scene, travel: float = 1.0) -> Scene:
     every = c.remesh_every
     # the re-equilibration after a remesh is an increment too: the k-th remesh follows increment k (every + 1) - 1
     # (a step cut shifts the later ones by one increment)
-    at = [k * (every + 1) - 1 for k in range(1, (steps - 1) // every + 1)] if every else []
+    # (a step cut shifts the later ones by one increment, and adds one: the list runs on to 3 times the steps, or
+    # a cut with many step cuts ran out of scheduled remeshes at 70 % of its travel, measured at edge size r/4)
+    at = [k * (every + 1) - 1 for k in range(1, 3 * steps // every + 1)] if every else []
     # uniform size fine * h (graded on p down to half of it at the edge, the isothermal cut stopped at 40 um
     # instead of 92.5, measured: "mesh would invert" after the second remesh)
     remesh = {"at": at, "indicator": "", "h": fine * g.h * MM, "max_remeshes": len(at) + 20,
               "relax_steps": RELAX_STEPS}
+    if c.edge_size is not None:      # graded: fine at the edge, coarse far away (size_zones)
+        remesh["h"] = FAR * fine * g.h * MM
+        remesh["zones"] = size_zones(c, tool["tip"], fine * g.h * MM, (every or 1) * cut / steps)
+        remesh["zones_follow"] = "tool"
+        # the first mesh too: the old boundary's chords at the edge (25 um on a 20 um edge radius) put the fine
+        # new boundary nodes up to 6 um inside the tool, and the first re-equilibration failed (measured)
+        geometry["refine"] = remesh["zones"][0]
     boundary = {}
     for name, b in scene.boundary.items():
         d = b.model_dump(exclude_none=True)
@@ -122,7 +151,7 @@ def fe_scene(scene, travel: float = 1.0) -> Scene:
         "material": {"E": scene.material.E * MPA, "nu": scene.material.nu},
         "elasticity": {"plane": "strain"},
         "plasticity": plasticity,
-        "kinematics": {"kind": "updated-lagrangian"},
+        "kinematics": {"kind": "updated-lagrangian", "volumetric": c.volumetric},
         "boundary": boundary,
         "contact": {"boundary": "free_surface", "normal": "+y", "obstacle": "tool",
                     "tool": {"vertices": tool["vertices"], "radii": tool["radii"]}, "friction": friction,

@@ -6,8 +6,9 @@ re-equilibration (by 25-30 % on the steel scene, measured) and recover over the 
 - ``raw``: :func:`wendel.cutting.chip.steady_state` (2 % over ``length``) on the increments, the
   re-equilibrations left out (a row at the travel of the one before);
 - ``cycles``: the same on the means over each remesh cycle (the increments from one re-equilibration to the
-  next, re-equilibration excluded), placed at the cycle's mean travel: the steady state of the cut seen over
-  the remesh period, which the saw-tooth does not hide.
+  next, re-equilibration excluded, each weighted by the travel it covers, so that a mean force is the work
+  over the travel even where steps were cut), placed at the cycle's mean travel: the steady state of the cut
+  seen over the remesh period, which the saw-tooth does not hide.
 
 :func:`gif` writes ``chip.gif`` from the frames with Pillow.
 
@@ -15,6 +16,10 @@ re-equilibration (by 25-30 % on the steel scene, measured) and recover over the 
 ...         for t in (0, 5, 5, 10, 15, 15, 20)]       # remeshed after 5 and 15 um: the 20 um cycle is cut short
 >>> [(round(r["tool_travel_m"] * 1e6, 1), r["increments"]) for r in cycle_means(rows)]
 [(2.5, 2), (12.5, 2)]
+>>> rows = [{"tool_travel_m": t * 1e-6, "Fc_N": f, "Ft_N": 50.0, "chip_thickness_m": 2e-4}
+...         for t, f in ((5, 100.0), (7.5, 300.0), (10, 300.0), (15, 100.0), (15, 50.0), (20, 100.0))]
+>>> round(cycle_means(rows)[0]["Fc_N"], 6)     # 5 um at 100 N, 2.5 + 2.5 um at 300 N, 5 um at 100 N (plain mean 200)
+166.666667
 """
 
 from __future__ import annotations
@@ -53,12 +58,22 @@ def cycle_means(rows: list[dict]) -> list[dict]:
         cycles = cycles[:-1]       # the last cycle, cut short by the end of the run: biased low, left out
     for c in cycles:
         m = {"tool_travel_m": float(np.mean([r["tool_travel_m"] for r in c])), "increments": len(c)}
+        w = _weights(rows, c)
         for k in SERIES:
             v = np.array([r[k] for r in c], dtype=float)
-            v = v[np.isfinite(v)]
-            m[k] = float(v.mean()) if len(v) else float("nan")
+            ok = np.isfinite(v)
+            m[k] = float(np.average(v[ok], weights=w[ok])) if ok.any() and w[ok].sum() > 0 else \
+                float(v[ok].mean()) if ok.any() else float("nan")
         out.append(m)
     return out
+
+
+def _weights(rows: list[dict], cycle: list[dict]) -> np.ndarray:
+    """Each increment's share of a cycle mean: the travel it covers since the row before it (a cut step covers
+    less), so that the mean of a force is the work over the travel."""
+    index = {id(r): k for k, r in enumerate(rows)}
+    t = [r["tool_travel_m"] for r in rows]
+    return np.array([max(t[index[id(r)]] - (t[index[id(r)] - 1] if index[id(r)] else 0.0), 0.0) for r in cycle])
 
 
 def _detect(rows: list[dict], length: float, tol: float):
@@ -74,15 +89,30 @@ def steady(rows: list[dict], length: float, tol: float = 0.02) -> dict:
     Also the spreads of the last window of that length, so that a cut that does not settle says how far off it is."""
     inc = [r for k, r in enumerate(rows) if not (k and abs(r["tool_travel_m"] - rows[k - 1]["tool_travel_m"]) <= 1e-12)]
     cyc = cycle_means(rows)
-    last = {}
+    last, trend = {}, {}
     for name, rr in (("raw", inc), ("cycles", cyc)):
         if rr:
             end = rr[-1]["tool_travel_m"]
             w = [r for r in rr if r["tool_travel_m"] >= end - length * (1 + 1e-9)]
+            ok = {k: len(w) > 1 and all(np.isfinite(r[k]) for r in w) for k in SERIES}
             last[name] = {k: (float(np.ptp([r[k] for r in w])) / abs(float(np.mean([r[k] for r in w])))
-                              if len(w) > 1 and all(np.isfinite(r[k]) for r in w) else None) for k in SERIES}
+                              if ok[k] else None) for k in SERIES}
+            trend[name] = {k: _trend(w, k, length) if ok[k] else None for k in SERIES}
     return {"length_m": length, "tol": tol, "raw": _detect(inc, length, tol), "cycles": _detect(cyc, length, tol),
-            "cycle_means": cyc, "last_window_spreads": last}
+            "cycle_means": cyc, "last_window_spreads": last, "last_window_trends": trend}
+
+
+def _trend(rows: list[dict], key: str, length: float) -> float:
+    """The change over ``length`` of travel of a least-squares line through the window, over its mean: the part
+    of a spread that is a drift (a cut still settling) rather than a scatter.
+
+    >>> round(_trend([{"tool_travel_m": t, "Fc_N": 99.0 + 2 * t} for t in (0.0, 0.5, 1.0)], "Fc_N", 1.0), 9)
+    0.02
+    """
+    x = np.array([r["tool_travel_m"] for r in rows])
+    v = np.array([r[key] for r in rows], dtype=float)
+    slope = np.polyfit(x, v, 1)[0] if np.ptp(x) > 0 else 0.0
+    return float(slope * length / abs(v.mean()))
 
 
 def gif(frames: Path, out: Path, every: int = 1, ms: int = 200) -> Path | None:

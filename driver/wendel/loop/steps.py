@@ -56,6 +56,10 @@ def cut_step(scene: Scene, files: RunFiles, state: State, failure: freefem.Newto
             state.cuts += 1
             progress(f"  increment {inc}: {reason} in the re-equilibration; again in {stages} stages")
             return
+        from ..remesh.again import remesh_again
+        if remesh_again(scene, files, state, progress):      # another mesh of the same body
+            state.cuts += 1
+            return
     state.cuts += 1
     mid = lf_prev + 0.5 * (lf_fail - lf_prev)
     smallest = scene.loading.nominal_step() / 2 ** scene.loading.max_cuts

@@ -17,9 +17,10 @@ groups of the new mesh, which is written as MSH 2.2 (what FreeFEM's ``gmshload``
 
 The size field is ``h`` where the nodal ``size_indicator`` (plastic strain, contact indicator, ...) is 0
 and ``h_min`` where it reaches its maximum, linear in between, given to gmsh as a post-processing
-view on the old deformed mesh (background mesh).
+view on the old deformed mesh (background mesh); size ``zones`` (boxes of a finer size, graded to ``h``
+outside them, e.g. around a cutting edge) are gmsh Box fields, the smallest size of all holding.
 
-Size: about 390 lines on purpose: one gmsh session per remesh, and the boundary extraction (labelled
+Size: about 430 lines on purpose: one gmsh session per remesh, and the boundary extraction (labelled
 facets, chains, loops, shells) feeds both the 2D and the 3D model builder; the pieces have no use apart.
 """
 
@@ -204,8 +205,21 @@ def _size_view(gmsh, points, cells, sizes):
     return view
 
 
+def _zone_field(gmsh, zone, h):
+    """A gmsh Box field: ``zone['h']`` inside ``zone['box'] = [lo, hi]``, growing linearly to ``h`` over
+    ``zone['thickness']`` outside it."""
+    f = gmsh.model.mesh.field.add("Box")
+    lo, hi = (list(c) + [0.0] * (3 - len(c)) for c in zone["box"])
+    for key, v in zip(("XMin", "YMin", "ZMin", "XMax", "YMax", "ZMax"), lo + hi):
+        gmsh.model.mesh.field.setNumber(f, key, float(v))
+    gmsh.model.mesh.field.setNumber(f, "Thickness", float(zone.get("thickness", 0.0)))
+    gmsh.model.mesh.field.setNumber(f, "VIn", float(zone["h"]))
+    gmsh.model.mesh.field.setNumber(f, "VOut", float(h))
+    return f
+
+
 def remesh(points_deformed, mesh_in_path, out_path, h, size_indicator=None, h_min=None,
-           feature_angle=30.0, optimize=True, algorithm_3d=10):
+           feature_angle=30.0, optimize=True, algorithm_3d=10, zones=None, algorithm_2d=None):
     """Mesh the deformed body anew from its boundary; write MSH 2.2 with the same labels.
 
     Parameters
@@ -224,12 +238,18 @@ def remesh(points_deformed, mesh_in_path, out_path, h, size_indicator=None, h_mi
         the size goes linearly from ``h`` (indicator 0) to ``h_min`` (indicator maximum).
     h_min : float, optional
         Smallest size (m); default ``h / 4``.
+    zones : list of dict, optional
+        Boxes of finer size: ``{"box": [lo, hi], "h": size, "thickness": t}``: ``size`` inside the box,
+        growing linearly to ``h`` over the distance ``t`` outside it (gmsh Box fields); with the indicator,
+        the smallest of all sizes holds at a point.
     feature_angle : float
         2D: boundary nodes where the boundary turns by more than this (degrees) stay nodes of the new mesh.
     optimize : bool
         3D: Netgen optimization of the tetrahedra (min SICN ~0.3 instead of ~0.005 for raw HXT output).
     algorithm_3d : int
         gmsh ``Mesh.Algorithm3D`` (10 = HXT, 1 = Delaunay).
+    algorithm_2d : int, optional
+        gmsh ``Mesh.Algorithm`` (default gmsh's 6 = Frontal-Delaunay; 5 = Delaunay, 1 = MeshAdapt).
 
     Returns
     -------
@@ -285,22 +305,35 @@ def remesh(points_deformed, mesh_in_path, out_path, h, size_indicator=None, h_mi
         g = gmsh.model.addPhysicalGroup(dim, entities, domain_label)
         gmsh.model.setPhysicalName(dim, g, _name(domain_label))
 
-        if size_indicator is None:
+        if size_indicator is None and not zones:
             gmsh.option.setNumber("Mesh.MeshSizeMin", h)
             gmsh.option.setNumber("Mesh.MeshSizeMax", h)
         else:
-            ind = np.asarray(size_indicator, dtype=float).reshape(n)
-            top = ind.max()
-            t = np.clip(ind / top, 0.0, 1.0) if top > 0 else np.zeros(n)
-            view = _size_view(gmsh, pts, cells, h + (h_min - h) * t)
-            f = gmsh.model.mesh.field.add("PostView")
-            gmsh.model.mesh.field.setNumber(f, "ViewTag", view)
+            fields, smallest = [], h
+            if size_indicator is not None:
+                ind = np.asarray(size_indicator, dtype=float).reshape(n)
+                top = ind.max()
+                t = np.clip(ind / top, 0.0, 1.0) if top > 0 else np.zeros(n)
+                view = _size_view(gmsh, pts, cells, h + (h_min - h) * t)
+                f = gmsh.model.mesh.field.add("PostView")
+                gmsh.model.mesh.field.setNumber(f, "ViewTag", view)
+                fields.append(f)
+                smallest = h_min
+            for z in zones or []:
+                fields.append(_zone_field(gmsh, z, h))
+                smallest = min(smallest, z["h"])
+            f = fields[0]
+            if len(fields) > 1:
+                f = gmsh.model.mesh.field.add("Min")
+                gmsh.model.mesh.field.setNumbers(f, "FieldsList", fields)
             gmsh.model.mesh.field.setAsBackgroundMesh(f)
-            gmsh.option.setNumber("Mesh.MeshSizeMin", h_min)
+            gmsh.option.setNumber("Mesh.MeshSizeMin", smallest)
             gmsh.option.setNumber("Mesh.MeshSizeMax", h)
             gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
             gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
             gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
+        if dim == 2 and algorithm_2d is not None:
+            gmsh.option.setNumber("Mesh.Algorithm", algorithm_2d)
         if dim == 3:
             gmsh.option.setNumber("Mesh.Algorithm3D", algorithm_3d)
             gmsh.option.setNumber("Mesh.OptimizeNetgen", 1 if optimize else 0)

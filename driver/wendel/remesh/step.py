@@ -31,6 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .again import AGAIN
 from . import quality       # mesher (meshio, gmsh) and transfer (scipy) when a run remeshes: a run without
                             # remeshing judges its mesh only and does not pay their imports
 from ..results import vtu
@@ -86,7 +87,7 @@ def yield_violation(eps0: np.ndarray, epsp: np.ndarray, sigma_y: np.ndarray, mu:
 def remesh_state(inc_dir: Path, mesh_old: Path, ubase_old: np.ndarray | None, dimension: int,
                  mesh_new: Path, state_new: Path, h: float, h_min: float, indicator: str,
                  mu: float | None = None, axisymmetric: bool = False, make_mesh=None,
-                 deformed: bool = True) -> dict:
+                 deformed: bool = True, zones: list[dict] | None = None, algorithm_2d: int | None = None) -> dict:
     """Mesh the deformed body of increment ``inc_dir`` anew and write the transferred state.
 
     Writes ``mesh_new`` and, in ``state_new``, ``u.node.txt`` (zeros), ``ubase.txt``, ``eps0.txt`` and the
@@ -95,7 +96,8 @@ def remesh_state(inc_dir: Path, mesh_old: Path, ubase_old: np.ndarray | None, di
     carried in ``eps0``.
     ``make_mesh`` replaces :func:`wendel.remesh.mesher.remesh` (same arguments and report keys), e.g. the material
     removal of :mod:`wendel.drilling`; ``deformed = False`` transfers in the reference configuration
-    (small strain: the new mesh is made from the original geometry).
+    (small strain: the new mesh is made from the original geometry); ``zones``: boxes of finer size
+    (:func:`wendel.remesh.mesher.remesh`).
     """
     from . import mesher, transfer
 
@@ -111,7 +113,9 @@ def remesh_state(inc_dir: Path, mesh_old: Path, ubase_old: np.ndarray | None, di
     if indicator and (inc_dir / f"{indicator}.cell.txt").is_file():
         size_ind = transfer.cell_to_nodes(xd, cells, cellfield(indicator)[:, 0], axisymmetric=axisymmetric)
     with _quiet_stdout():
-        info = (make_mesh or mesher.remesh)(xd, mesh_old, mesh_new, h, size_indicator=size_ind, h_min=h_min)
+        info = (make_mesh or mesher.remesh)(xd, mesh_old, mesh_new, h, size_indicator=size_ind, h_min=h_min,
+                                            **({"zones": zones} if zones else {}),
+                                            **({"algorithm_2d": algorithm_2d} if algorithm_2d is not None else {}))
     t1 = time.perf_counter()
     Y, new_cells = vtu.read_mesh(mesh_new, dimension)
     Y = Y[:, :dimension]
@@ -241,7 +245,18 @@ def finish_report(report: dict, reeq_dir: Path, path: Path) -> dict:
     return report
 
 
-def maybe_remesh(scene, files, state, dimension: int, progress) -> None:
+def zones_at(r, inc_dir: Path) -> list[dict]:
+    """The size zones of ``remesh`` (``r``) for the remesh after increment ``inc_dir``: as written, or moved by
+    the tool's placement (``tool_x``, ``tool_y``(, ``tool_z``) of its record.json) when they follow the tool."""
+    shift = np.zeros(3)
+    if r.zones and r.zones_follow == "tool":
+        rec = json.loads((inc_dir / "record.json").read_text())
+        shift = np.array([float(rec.get(f"tool_{a}", 0.0)) for a in "xyz"])
+    return [{"box": [[c + d for c, d in zip(corner, shift)] for corner in z.box], "h": z.h, "thickness": z.thickness}
+            for z in r.zones]
+
+
+def maybe_remesh(scene, files, state, dimension: int, progress, again: int = 0) -> None:
     """The loop's remesh step: after the last accepted increment, remesh when its deformed mesh is too poor
     (or the scene asks); the next launch re-equilibrates the transferred state at the same load factor.
 
@@ -271,8 +286,11 @@ def maybe_remesh(scene, files, state, dimension: int, progress) -> None:
     rep = remesh_state(files.fem / f"inc-{inc:04d}", files.root / seg["mesh"], ubase_old, dimension,
                                  files.root / mesh_new, files.root / state_dir, h, r.h_min or h / 3, r.indicator,
                                  mu=scene.material.E / (2 * (1 + scene.material.nu)),
-                                 axisymmetric=scene.elasticity.plane == "axisymmetric")
-    rep.update({"remesh": k, "after_increment": inc, "load_factor": lf})
+                                 axisymmetric=scene.elasticity.plane == "axisymmetric",
+                                 zones=zones_at(r, files.fem / f"inc-{inc:04d}"),
+                                 algorithm_2d=AGAIN[again - 1] if again else None)
+    rep.update({"remesh": k, "after_increment": inc, "load_factor": lf, "dimension": dimension,
+                "algorithm_2d_tries": again})
     state.remeshes.append(rep)
     state.segments.append({"first": inc + 1, "mesh": mesh_new, "ubase": f"{state_dir}/ubase.txt",
                            "eps0": f"{state_dir}/eps0.txt", "state": state_dir})

@@ -251,6 +251,25 @@ class Output(Strict):
     warp: float = Field(0.0, ge=0, description="displacement scale of the picture; 0 = automatic")
 
 
+class RemeshZone(Strict):
+    """A box of finer size for the new meshes, graded to remesh.h outside it (``wendel.remesh.mesher``)."""
+
+    box: list[list[float]] = Field(..., min_length=2, max_length=2, description="lower and upper corner "
+                                   "[[x, y(, z)], [x, y(, z)]] [m]")
+    h: float = Field(..., gt=0, description="element size inside the box [m]")
+    thickness: float = Field(0.0, ge=0, description="distance outside the box over which the size grows "
+                             "linearly to remesh.h [m]")
+
+    @field_validator("box")
+    @classmethod
+    def _box(cls, v):
+        if any(len(c) not in (2, 3) or len(c) != len(v[0]) for c in v) or any(not abs(x) < 1e30 for c in v for x in c):
+            raise ValueError(f"box: two corners of 2 or 3 finite coordinates, got {v}")
+        if any(a > b for a, b in zip(*v)):
+            raise ValueError(f"box: the lower corner must be below the upper one, got {v}")
+        return v
+
+
 class Remesh(Strict):
     """Remeshing of the deformed body (its presence enables it): when the deformed mesh's quality falls
     below the threshold, gmsh meshes the deformed configuration anew and the state is transferred."""
@@ -264,6 +283,11 @@ class Remesh(Strict):
     relax_steps: int = Field(1, ge=1, le=64, description="the re-equilibration after a remesh releases the "
                              "transferred state's out-of-balance forces in this many stages, each converged by "
                              "Newton (1: at once) [1]")
+    zones: list[RemeshZone] = Field(default_factory=list, description="boxes of finer size [[remesh.zones]] "
+                                    "(box, h, thickness), graded to remesh.h outside them")
+    zones_follow: Literal["body", "tool"] = Field("body", description="body: the zones stand where they are "
+                                                  "written; tool: they move with contact.path (written for "
+                                                  "the tool at load factor 0)")
 
 
 class Reference(Strict):
@@ -379,6 +403,9 @@ class SceneBase(Strict):
             raise ValueError("kinematics.volumetric needs kinematics.kind = \"updated-lagrangian\"")
         if self.body_force.kind == "manufactured" and self.reference.analytic is None:
             raise ValueError("body_force.kind = \"manufactured\" needs reference.analytic")
+        if self.remesh is not None and self.remesh.zones_follow == "tool" and \
+                getattr(getattr(self, "contact", None), "path", None) is None:
+            raise ValueError("remesh.zones_follow = \"tool\" needs a moving tool (contact.path)")
         check_kernels(self)                # numerics.assembly = "compiled" against the other tables
         if self.problem == "mechanics":
             check_axisymmetric(self)       # elasticity.plane/order/reference against the other tables

@@ -18,7 +18,7 @@ isothermal prototype, :data:`FE_READY`).
 
 from __future__ import annotations
 
-from typing import Optional
+from typing import Literal, Optional
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
@@ -73,6 +73,13 @@ class Cutting(BaseModel):
                                         "load factor 0 -> 1 [m]; default 2 uncut_thickness")
     remesh_every: int = Field(4, ge=0, le=1000, description="FE: remesh the deformed workpiece after every this "
                               "many increments (0: only when the element quality falls below 0.1) [1]")
+    edge_size: Optional[float] = Field(None, gt=0, description="FE: element size of the remeshes at the cutting "
+                                       "edge [m], graded to geometry.fine * geometry.h around the primary shear "
+                                       "zone and the rake contact and to twice that elsewhere "
+                                       "(wendel.cutting.fe.size_zones); default: uniform geometry.fine * geometry.h")
+    volumetric: Literal["cell", "fbar"] = Field("cell", description="FE: the updated-Lagrangian volume change, "
+                                                "per cell (P1, locks in the isochoric plastic flow) or F-bar "
+                                                "(kinematics.volumetric)")
     oxley: OxleyConstants = OxleyConstants()
 
     @model_validator(mode="after")
@@ -80,6 +87,9 @@ class Cutting(BaseModel):
         if self.edge_radius > 0.5 * self.uncut_thickness:
             raise ValueError(f"edge_radius ({self.edge_radius:g} m) above half the uncut_thickness "
                              f"({self.uncut_thickness:g} m): the cut is ploughing, outside this model")
+        if self.edge_size is not None and self.edge_size > self.uncut_thickness:
+            raise ValueError(f"edge_size ({self.edge_size:g} m) above the uncut_thickness ({self.uncut_thickness:g} m): "
+                             "the edge would be coarser than the chip")
         if self.rake + self.clearance >= 80:
             raise ValueError(f"rake + clearance = {self.rake + self.clearance:g} deg leaves a wedge under 10 deg")
         return self

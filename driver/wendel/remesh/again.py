@@ -1,0 +1,30 @@
+"""A remesh made again when its re-equilibration fails: the same deformed body, the same sizes, other triangles.
+
+Whether the re-equilibration after a remesh converges depends on the mesh (measured on the FE cut: at an
+edge size of r/1 and r/3 a re-equilibration failed even in 64 stages where the other resolutions went on).
+"""
+
+from __future__ import annotations
+
+
+AGAIN = (5, 1)      # gmsh 2D algorithms (Delaunay, MeshAdapt) of a remesh made again after its re-equilibration failed
+
+
+def remesh_again(scene, files, state, progress) -> bool:
+    """The re-equilibration after the last remesh failed even in the most stages: mesh the same deformed body
+    again with the next gmsh 2D algorithm of ``AGAIN`` (the same sizes, other triangles; whether a
+    re-equilibration converges depends on the mesh: measured on the FE cut) and re-equilibrate that. False when
+    every algorithm has been tried (or in 3D)."""
+    rep = state.remeshes[-1]
+    tried = rep.get("algorithm_2d_tries", 0)
+    if rep.get("dimension") != 2 or tried >= len(AGAIN):
+        return False
+    state.remeshes.pop()
+    state.segments.pop()
+    state.pending.pop(0)
+    state.reequilibrate = False
+    progress(f"  increment {rep['after_increment']}: the re-equilibration failed; meshing again with gmsh algorithm "
+             f"{AGAIN[tried]}")
+    from .step import maybe_remesh
+    maybe_remesh(scene, files, state, 2, progress, again=tried + 1)
+    return True

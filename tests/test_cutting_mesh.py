@@ -1,0 +1,80 @@
+"""Orthogonal cutting, the graded mesh (issue 17): fine at the cutting edge, coarse far from it.
+
+``cutting.edge_size`` makes :func:`wendel.cutting.fe.fe_scene` refine the first mesh at the edge (the
+builder's ``refine``) and give the remeshes size zones that follow the tool (``remesh.zones``,
+``zones_follow = "tool"``). On real gmsh meshes of the steel scene's workpiece: the first mesh and a remesh with
+the tool moved 0.1 mm must have elements of the edge size at the edge, of the middle size over the primary
+shear zone, and twice that far away."""
+
+import json
+
+import numpy as np
+import pytest
+
+from wendel.cutting.fe import FAR, fe_scene, tool_at_start
+from wendel.scene.reading import SceneError
+from wendel.meshes.cutting import orthogonal_cutting
+from wendel.remesh import mesher
+from wendel.remesh.step import zones_at
+from wendel.scene import load
+
+from conftest import WORKFLOWS
+
+STEEL = WORKFLOWS / "cutting-aisi1045.toml"
+
+
+def _longest_edges(path):
+    p, _, cells, *_ = mesher.read_mesh(path)
+    xy = p[:, :2]
+    longest = np.max([np.linalg.norm(xy[cells[:, i]] - xy[cells[:, (i + 1) % 3]], axis=1) for i in range(3)], axis=0)
+    return xy[cells].mean(axis=1), longest
+
+
+def _near(centres, longest, point, radius):
+    return longest[np.linalg.norm(centres - point, axis=1) < radius]
+
+
+def test_graded_mesh_is_fine_at_the_edge_and_coarse_far_away(tmp_path):
+    scene = load(STEEL)
+    scene.cutting.edge_size = 5e-6             # m: r_edge / 4
+    fe = fe_scene(scene)
+    g = fe.geometry.model_extra
+    r, s = scene.cutting.edge_radius * 1e3, 5e-3                          # mm
+    h_mid = g["fine"] * fe.geometry.h
+    assert fe.remesh.zones_follow == "tool" and fe.remesh.h == pytest.approx(FAR * h_mid)
+    assert [z.h for z in fe.remesh.zones] == pytest.approx([s, h_mid])
+    tip = np.array(tool_at_start(scene.cutting, g["length"] - g["pre_cut"])["tip"])
+    built = orthogonal_cutting(tmp_path / "w.msh", h=fe.geometry.h,
+                               **{k: g[k] for k in ("length", "depth", "uncut", "pre_cut", "fine", "refine")})
+    c, longest = _longest_edges(built.path)
+    corner = [g["length"] - g["pre_cut"], 0.0]                           # the step face's foot, the edge in front
+    assert _near(c, longest, corner, r).max() < 1.5 * s                 # the first mesh: fine at the edge
+    # a remesh with the tool moved 0.1 mm along its path (the record's placement): the zones move with it
+    inc = tmp_path / "inc"
+    inc.mkdir()
+    (inc / "record.json").write_text(json.dumps({"tool_x": -0.1, "tool_y": 0.0}))
+    zones = zones_at(fe.remesh, inc)
+    assert zones[0]["box"][0][0] == pytest.approx(fe.remesh.zones[0].box[0][0] - 0.1)
+    points = mesher.read_mesh(built.path)[0]
+    info = mesher.remesh(points[:, :2], built.path, tmp_path / "r.msh", fe.remesh.h, zones=zones)
+    c, longest = _longest_edges(tmp_path / "r.msh")
+    edge = tip + [-0.1, r]
+    assert _near(c, longest, edge, r).max() < 1.5 * s                   # the edge size at the moved edge
+    assert np.median(_near(c, longest, edge + [-2 * 0.15, 0.1], 0.03)) == pytest.approx(h_mid, rel=0.35)
+    far = longest[(c[:, 1] < -0.3) | (c[:, 0] < 0.5)]                     # the deep bulk and the layer far ahead
+    assert np.median(far) == pytest.approx(FAR * h_mid, rel=0.3) and far.min() > 2 * s
+    # cheaper than a uniform mesh at the middle size (about 4,400 elements on this body, measured)
+    assert info["elements"] < 3500 and info["inverted"] == 0
+
+
+def test_bad_zones_are_refused_with_the_key(tmp_path):
+    text = STEEL.read_text().replace("remesh_every = 8 ", "edge_size = 0.2e-3\nremesh_every = 8 ")
+    bad = tmp_path / "bad.toml"
+    bad.write_text(text)
+    with pytest.raises(SceneError, match="edge_size"):
+        load(bad)
+    with pytest.raises(ValueError, match="zones_follow"):
+        fe = fe_scene(load(STEEL)).model_dump()
+        fe["remesh"]["zones_follow"] = "tool"
+        fe["contact"]["path"] = None
+        type(fe_scene(load(STEEL))).model_validate(fe)
