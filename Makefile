@@ -14,6 +14,8 @@ SCENE ?= workflows/drilling-rz.toml   # the product's main job: a small drilling
 .PHONY: setup run test bench dealii clean
 setup: build/.apt-ok $(VENV)/.ok build/plugins/MUMPS_mpi.so build/plugins/wendel_petsc.so build/plugins/wendel_tool.so \
        build/plugins/wendel_kernels.so
+	@# wendel's own bytecode, where PYTHONDONTWRITEBYTECODE=1 would compile it at every start (issue 20)
+	@$(VENV)/bin/python -m compileall -q driver/wendel meshes > /dev/null
 
 # Debian packages: FreeFEM, Open MPI, OpenBLAS under FreeFEM's direct solvers, Mesa for off-screen pictures.
 build/.apt-ok: Makefile scripts/apt-ensure.sh

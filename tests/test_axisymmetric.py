@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from wendel.loop import run
+from wendel.results.vtu import read_array
 from wendel.results.study import study
 
 from conftest import WORKFLOWS
@@ -39,8 +40,8 @@ def test_thick_sphere_stresses_match_lame(tmp_path, quiet):
     assert 0 < rec["error_lame_stress_l2"] < 1e-3, rec["error_lame_stress_l2"]
     assert 0 < rec["error_lame_stress"] < 4e-3, rec["error_lame_stress"]
     # u_r = 0 on the axis (the scene names no condition there), u_z free; the bore opens
-    xyz = np.array((root / "fem" / "vertices.txt").read_text().split()[1:], float).reshape(3, -1)
-    u = np.array((root / "fem" / "inc-0001" / "u.node.txt").read_text().split()[1:], float).reshape(-1, 2)
+    xyz = read_array(root / "fem" / "vertices.txt").reshape(3, -1)
+    u = read_array(root / "fem" / "inc-0001" / "u.node.txt").reshape(-1, 2)
     on_axis = np.abs(xyz[0]) < 1e-12
     assert on_axis.sum() > 10 and np.all(u[on_axis, 0] == 0) and np.abs(u[on_axis, 1]).max() > 0
     # Lame: u(a) = p a / E [(1 - 2 nu) a^3 + (1 + nu) b^3 / 2] / (b^3 - a^3) at the bore
@@ -228,7 +229,7 @@ def test_remeshed_plastic_sphere_keeps_its_state(tmp_path, quiet):
     assert last["plastic_volume"] == pytest.approx(ref["plastic_volume"], rel=0.05)
     # the displacement reached (u_total = ubase + u since the remesh) at the bore
     fem = root / "fem"
-    ut = np.array((sorted(fem.glob("inc-*"))[-1] / "u_total.node.txt").read_text().split()[1:], float).reshape(-1, 2)
+    ut = read_array(sorted(fem.glob("inc-*"))[-1] / "u_total.node.txt").reshape(-1, 2)
     assert np.hypot(ut[:, 0], ut[:, 1]).max() == pytest.approx(ref["max_displacement"], rel=0.02)
 
 

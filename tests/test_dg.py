@@ -67,6 +67,8 @@ def test_a_penalty_below_the_stability_bound_is_warned_about_and_spoils_the_solu
     (("gamma_mu = 20.0 ", "gamma_mu = -1.0 "), "discretization.gamma_mu"),
     (("kind = \"dg\"", "kind = \"hdg\""), "discretization.kind"),
     (("[numerics]", "[elasticity]\norder = 2\n\n[numerics]"), "elasticity.order = 1"),
+    (("kind = \"dg\"", "kind = \"dg\"\nafter_separation = \"cg\""), "after_separation = 'cg' needs separation_stress"),
+    (("kind = \"dg\"", "kind = \"cg\"\nafter_separation = \"cg\""), "after_separation needs discretization.kind"),
 ])
 def test_what_dg_does_not_join_is_refused_when_the_scene_is_read(scene_file, change, message):
     path = scene_file(edit((WORKFLOWS / "dg-mms.toml").read_text(), *change))
@@ -126,6 +128,8 @@ def test_a_killed_dg_plastic_run_resumes_to_the_same_result(tmp_path):
 
     import numpy as np
 
+    from wendel.results.vtu import read_array
+
     cmd = [sys.executable, "-m", "wendel.cli", "run"]
     scene = str(WORKFLOWS / "cylinder-dg.toml")
     assert subprocess.run(cmd + [scene, "--smoke", "--out", str(tmp_path / "ref")], capture_output=True).returncode == 0
@@ -143,8 +147,8 @@ def test_a_killed_dg_plastic_run_resumes_to_the_same_result(tmp_path):
     for a, b in zip(*rows):
         for key in ("strain_energy", "max_displacement", "max_plastic_strain"):
             assert float(a[key]) == pytest.approx(float(b[key]), rel=1e-9), (key, a, b)
-    last = lambda d: sorted((d / "fem").glob("inc-*/u_dg.qp.txt"))[-1].read_text().split()
-    np.testing.assert_allclose(np.array(last(tmp_path / "ref"), float), np.array(last(killed), float), rtol=1e-9, atol=1e-14)
+    last = lambda d: read_array(sorted((d / "fem").glob("inc-*/u_dg.qp.txt"))[-1])
+    np.testing.assert_allclose(last(tmp_path / "ref"), last(killed), rtol=1e-9, atol=1e-14)
 
 
 CONTINUE = """description = "the separated notched plate continued with CG: a pressure opens the cut"
@@ -218,12 +222,16 @@ def test_the_notched_plate_separates_across_its_ligament_and_the_force_drops(tmp
         jump = np.array([np.linalg.norm(u[i] - u[j]) for i, j in split])
         # the two copies of a vertex on the cut move apart (a CG field on the uncut mesh has one value there)
         assert np.median(jump) > 0.1 * np.abs(u).max(), (jump, np.abs(u).max())
-        # remeshing the cut body is refused with a message (gmsh did not finish meshing it: measured, > 10 min)
+        # the cut bodies are remeshed (deformed, the two sides glued at their mean, the cut embedded and opened
+        # again: remesh/bodies.py; before session 6 gmsh had not finished after 10 min) and the run goes on
         remeshed = scene_file(CONTINUE.format(mesh=root / "separated.msh").replace(
             '[numerics]', '[loading]\nsteps = 2\n[remesh]\nat = [1]\nindicator = ""\n[numerics]'), "cont-remesh.toml")
-        with pytest.raises(ValueError, match="opened faces"):
-            run(remeshed, out=tmp_path / "cont-remesh", png=False, progress=quiet)
-        assert (tmp_path / "cont-remesh" / "fem" / "inc-0001" / "done").is_file()     # increment 1 is kept
+        rroot = run(remeshed, out=tmp_path / "cont-remesh", png=False, progress=quiet)
+        assert (rroot / "fem" / "inc-0003" / "done").is_file()          # 2 increments and the re-equilibration
+        new = meshio.read(rroot / "meshes" / "mesh-1.msh", file_format="gmsh")
+        assert new.field_data["opened"].tolist() == [31, 1]
+        from wendel.remesh.bodies import body_index
+        assert body_index(new.cells_dict["triangle"]).max() + 1 == rep["bodies"]
 
 
 def test_a_killed_separating_run_resumes_to_the_same_result(tmp_path):
@@ -250,5 +258,5 @@ def test_a_killed_separating_run_resumes_to_the_same_result(tmp_path):
         [(r_["newton_iterations"], r_["dg_open_faces"]) for r_ in recs[1]]
     for a, b in zip(*recs):
         assert a["dg_reaction_y"] == pytest.approx(b["dg_reaction_y"], rel=1e-8, abs=1e-3)
-    assert (tmp_path / "ref" / "fem" / "inc-0010" / "dg_open.edge.txt").read_text() == \
-        (killed / "fem" / "inc-0010" / "dg_open.edge.txt").read_text()
+    assert (tmp_path / "ref" / "fem" / "inc-0010" / "dg_open.edge.txt").read_bytes() == \
+        (killed / "fem" / "inc-0010" / "dg_open.edge.txt").read_bytes()

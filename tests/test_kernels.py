@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from wendel.loop import run_scene
+from wendel.results.vtu import read_array
 from wendel.scene import load
 
 from conftest import WORKFLOWS
@@ -26,8 +27,8 @@ def ball(out, assembly: str, solver: str = "cg", ranks: int = 1) -> tuple[dict, 
     scene.output.png = False
     scene.output.vtu = False
     root = run_scene(scene, path, out, smoke=True, progress=lambda *_: None)
-    u = sorted(root.glob("fem/inc-*/u.node.txt"))[-1].read_text().split()[1:]
-    return json.loads((root / "summary.json").read_text()), np.array([float(x) for x in u])
+    u = read_array(sorted(root.glob("fem/inc-*/u.node.txt"))[-1])
+    return json.loads((root / "summary.json").read_text()), u
 
 
 @pytest.fixture(scope="module")

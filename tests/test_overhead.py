@@ -165,6 +165,15 @@ def test_accepting_while_freefem_solves_gives_the_same_run(tmp_path, monkeypatch
         raw = f.read_bytes()
         assert raw[7] == 0 and len(raw) == 8 + 8 * int.from_bytes(raw[:8], "little") and complete_array(f), f
         np.testing.assert_array_equal(read_array(f), np.ravel(cell_data[f.name.removesuffix(".cell.txt")][0]))
+    # node fields and quadrature-point state too (issue 20); after each remesh FreeFEM read the driver's text
+    # state (the same run as above: the increments after a remesh continued from it)
+    state = sorted((behind / "fem" / last.stem).glob("*.node.txt")) + sorted((behind / "fem" / last.stem).glob("*.qp.txt"))
+    assert {"u.node.txt", "plast_epsp.qp.txt"} <= {f.name for f in state}
+    for f in state:
+        raw_state = f.read_bytes()
+        assert raw_state[7] == 0 and complete_array(f) and read_array(f).size > 0, f
+    driver_text = sorted((behind / "remesh").glob("state-*/plast_epsp.qp.txt"))
+    assert s1["remeshes"] and driver_text and all(p.read_bytes().split(b"\n", 1)[0].isdigit() for p in driver_text)
     cut = tmp_path / "cut.cell.txt"
     cut.write_bytes(raw[:-3])
     assert not complete_array(cut)
@@ -187,3 +196,53 @@ def test_the_run_takes_the_picture_process_started_before_its_mesh():
     other = pictures.painter("pyvista")
     other.close(at_once=True)
     assert other is not early and not pictures._EARLY and early.proc.poll() is not None
+
+
+@pytest.mark.parametrize("scene", ["smoke", "hertz-3d", "thermo-constrained"])
+def test_elastic_strain_energy_on_one_point_is_the_integral_of_its_cell_fields(scene, tmp_path):
+    """Elastic P1 (2D plane strain, 3D, 3D with a thermal stress): the record's strain energy (FreeFEM's
+    one-point rule since issue 20) equals 0.5 sum over cells |K| sigma : eps, computed here from the VTU's
+    cell strains, E and nu (and alpha, the temperature at the cell's centroid)."""
+    from wendel.loop import run
+
+    root = run(WORKFLOWS / f"{scene}.toml", smoke=True, out=tmp_path / scene, progress=lambda *a: None)
+    mat = json.loads((root / "scene.resolved.json").read_text())["material"]
+    lam = mat["E"] * mat["nu"] / ((1 + mat["nu"]) * (1 - 2 * mat["nu"]))
+    mu = mat["E"] / (2 * (1 + mat["nu"]))
+    m = meshio.read(sorted((root / "vtu").glob("inc-*.vtu"))[-1])
+    kind = "tetra" if any(b.type == "tetra" for b in m.cells) else "triangle"
+    cells = np.concatenate([b.data for b in m.cells if b.type == kind])
+    x = m.points[cells]
+    if kind == "tetra":
+        vol = np.abs(np.linalg.det(x[:, 1:] - x[:, :1])) / 6
+        axes = "xyz"
+    else:
+        d = x[:, 1:, :2] - x[:, :1, :2]
+        vol = np.abs(d[:, 0, 0] * d[:, 1, 1] - d[:, 0, 1] * d[:, 1, 0]) / 2
+        axes = "xy"
+    eps = {(a, b): np.concatenate(m.cell_data[f"strain_{min(a, b)}{max(a, b)}"]) for a in axes for b in axes}
+    trace = sum(eps[a, a] for a in axes)
+    density = sum((lam * trace * (a == b) + 2 * mu * eps[a, b]) * eps[a, b] for a in axes for b in axes)
+    thermal = json.loads((root / "scene.resolved.json").read_text()).get("thermal")
+    if thermal:           # sigma = C eps - 3 K alpha (T - T_ref) I, T linear: its centroid value
+        t_centroid = np.asarray(m.point_data["T"])[cells].mean(axis=1)
+        density = density - 3 * (lam + 2 * mu / 3) * thermal["alpha"] * (t_centroid - thermal["T_ref"]) * trace
+    energy = 0.5 * (vol * density).sum()
+    record = json.loads(sorted((root / "fem").glob("inc-*/record.json"))[-1].read_text())
+    assert energy > 0
+    assert record["strain_energy"] == pytest.approx(energy, rel=1e-10)
+
+
+def test_provenance_is_written_at_once_and_completed_by_the_summary(tmp_path):
+    """provenance.json exists with ``smoke`` (what a resume needs) when write_provenance returns; the commit
+    and the versions, looked up in a thread, are in it once the run's summary is written."""
+    from wendel.results import summary
+    from wendel.scene import load
+
+    scene_path = WORKFLOWS / "smoke.toml"
+    summary.write_provenance(tmp_path, scene_path, load(scene_path), smoke=True)
+    assert json.loads((tmp_path / "provenance.json").read_text())["smoke"] is True
+    summary.provenance_done(tmp_path)
+    prov = json.loads((tmp_path / "provenance.json").read_text())
+    assert prov["smoke"] is True and prov["git_commit"] and prov["versions"]["freefem++"].startswith("4.")
+    assert not list(tmp_path.glob("*.tmp"))

@@ -42,6 +42,18 @@ class FreeFemTimeout(FreeFemError):
     """A launch ran past its time limit and was stopped."""
 
 
+def read_json(text: str) -> dict:
+    """JSON that FreeFEM wrote, whose numbers may be C's ``nan``, ``-nan``, ``inf`` (a diverged Newton step).
+
+    >>> read_json('{"residual": -nan, "r": inf, "s": -inf}')
+    {'residual': nan, 'r': inf, 's': -inf}
+    """
+    import re
+
+    text = re.sub(r"(:\s*)-?nan\b", r"\1NaN", text)
+    return json.loads(re.sub(r"(:\s*)(-?)inf\b", r"\1\2Infinity", text))
+
+
 class NewtonFailure(RuntimeError):
     """An increment did not converge; ``record`` is edp's failed.json (increment, load factor, reason)."""
 
@@ -172,7 +184,7 @@ def run(entry: str, options: list[str], out_dir: Path, ranks: int = 1, timeout: 
     if rc == 0:
         return Launch(wall, cmd)
     if rc == EXIT_NEWTON and (out_dir / "failed.json").is_file():
-        raise NewtonFailure(json.loads((out_dir / "failed.json").read_text()))
+        raise NewtonFailure(read_json((out_dir / "failed.json").read_text()))
     if (out_dir / "error.txt").is_file():
         raise FreeFemError((out_dir / "error.txt").read_text().strip(), str(script), None, log)
     text = log.read_text(errors="replace")

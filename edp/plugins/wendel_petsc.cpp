@@ -19,12 +19,17 @@
 //   bs       block size (the space dimension for a displacement field, 1 for a scalar field).
 //   options  PETSc options, "-name value" tokens (checked by the caller; lib/solver.idp adds its presets).
 //            Besides PETSc's own: -wendel_pc_reuse 0|1 (default 1): keep the preconditioner of an earlier
-//            matrix with the same pattern, rebuilt when a solve needs more than 1.5x the iterations of the
-//            solve right after its setup, or fails.
+//            matrix with the same pattern, rebuilt when the iterations it has cost beyond those of a fresh one
+//            (at the convergence rate of the solve right after its setup) add up to more than its setup time,
+//            or when a solve on it fails.
 //   info     output, resized to 6: iterations, true relative residual ||b - A x|| / ||b||, KSP converged
 //            reason (> 0 converged), 1 if the preconditioner was reused, seconds in CSR + setup, seconds
 //            in the Krylov solve.
 //   returns  the iterations; a PETSc error or a solve that does not converge stops the script (ExecError).
+//
+//   wendelPetscRtol(real rtol): the relative tolerance of the following solves (an inexact Newton's forcing
+//   term, set before each solve by lib/solver.idp); 0 (the start) leaves the options' -ksp_rtol in force.
+//   Kept apart from the options string so that a new tolerance keeps the cached solver and preconditioner.
 //
 // On N MPI ranks (FreeFem++-mpi) every rank passes the same whole system; each rank builds its block of
 // rows (whole nodes) of an MPIAIJ matrix, the solve runs on all ranks, and every rank gets the whole x.
@@ -63,11 +68,14 @@ struct Cache {
     PetscInt rstart = 0, rend = 0;             // this rank's rows (whole nodes: multiples of bs)
     PetscMPIInt size = 1;
     bool reuse = true;
-    PetscInt itsAtSetup = 0;
+    double rateAtSetup = 0;                    // digits of residual reduction per iteration after the setup
+    double setupCost = 0;                      // s, the last setup of the preconditioner
+    double extraCost = 0;                      // s, iterations beyond the setup's rate since then (kept one)
     bool stale = true;                         // rebuild the preconditioner at the next solve
 };
 Cache cache;
 bool petscUp = false;
+double forcedRtol = 0;                         // wendelPetscRtol: > 0 overrides -ksp_rtol
 
 PetscErrorCode destroyCache()
 {
@@ -292,28 +300,48 @@ PetscErrorCode solve(Matrice_Creuse<double>* K, KN<double>* b, KN<double>* x, KN
     KSPConvergedReason reason = KSP_CONVERGED_ITERATING;
     PetscInt its = 0;
     double tSetup = 0, tSolve = 0;
+    if (forcedRtol > 0) PetscCall(KSPSetTolerances(cache.ksp, forcedRtol, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT));
+    PetscReal bnorm;
+    PetscCall(VecNorm(cache.b, NORM_2, &bnorm));
     for (int attempt = 0; attempt < 2; ++attempt) {
         reused = !cache.stale && cache.reuse;
         PetscCall(KSPSetReusePreconditioner(cache.ksp, reused ? PETSC_TRUE : PETSC_FALSE));
         double t1 = seconds();
         PetscCall(KSPSetUp(cache.ksp));
+        PC pc;                                 // set up here, not inside KSPSolve, so that its time is its own
+        PetscCall(KSPGetPC(cache.ksp, &pc));
+        PetscCall(PCSetUp(pc));
         PetscCall(KSPSetUpOnBlocks(cache.ksp));
         double t2 = seconds();
         tSetup += t2 - t1;
         PetscCall(KSPSolve(cache.ksp, cache.b, cache.x));
-        tSolve += seconds() - t2;
+        double t3 = seconds();
+        tSolve += t3 - t2;
         PetscCall(KSPGetConvergedReason(cache.ksp, &reason));
         PetscCall(KSPGetIterationNumber(cache.ksp, &its));
+        // Keep the preconditioner while the iterations it costs beyond those of a fresh one (at the rate,
+        // digits of residual per iteration, of the solve right after its setup) add up to less than a setup;
+        // rates rather than counts, since a forcing term changes the tolerance from solve to solve.
+        PetscReal rnorm = 0;
+        PetscCall(KSPGetResidualNorm(cache.ksp, &rnorm));
+        double digits = (rnorm > 0 && bnorm > 0) ? std::log10(bnorm / rnorm) : 0;
         if (!reused) {
-            cache.itsAtSetup = its;
+            cache.rateAtSetup = its > 0 ? digits / its : 0;
+            cache.setupCost = t2 - t1;
+            cache.extraCost = 0;
             cache.stale = false;
             break;
         }
         if (reason > 0) {
-            if (2 * its > 3 * cache.itsAtSetup) cache.stale = true;   // next solve sets the preconditioner up anew
+            double fresh = cache.rateAtSetup > 0 ? digits / cache.rateAtSetup : 0;
+            if (its > 0 && its > fresh) cache.extraCost += (its - fresh) * (t3 - t2) / its;
+            int stale = cache.extraCost > cache.setupCost;                // set up anew at the next solve
+            if (cache.size > 1)                // times differ between ranks: the setup is collective, decide together
+                PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &stale, 1, MPI_INT, MPI_MAX, PETSC_COMM_WORLD));
+            if (stale) cache.stale = true;
             break;
         }
-        cache.stale = true;                                           // the kept one failed: set up and solve again
+        cache.stale = true;                                               // the kept one failed: set up and solve again
     }
     cache.stale = cache.stale || !cache.reuse;
     PetscCheck(reason > 0, PETSC_COMM_SELF, PETSC_ERR_NOT_CONVERGED,
@@ -364,8 +392,15 @@ long wendelPetscSolve(Matrice_Creuse<double>* const& K, KN<double>* const& b, KN
 
 }  // namespace
 
+double wendelPetscRtol(const double& rtol)
+{
+    forcedRtol = rtol;
+    return rtol;
+}
+
 static void Load_Init()
 {
+    Global.Add("wendelPetscRtol", "(", new OneOperator1_<double, double>(wendelPetscRtol));
     Global.Add("wendelPetscSolve", "(",
                new OneOperator8_<long, Matrice_Creuse<double>*, KN<double>*, KN<double>*, KN<double>*, KN<double>*,
                                  long, string*, KN<double>*>(wendelPetscSolve));

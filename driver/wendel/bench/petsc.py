@@ -8,7 +8,7 @@ seconds per Newton step of the linear solve (CSR conversion, preconditioner setu
 included), of the assembly (and of the tangent matrix alone) and of the constitutive update, the Krylov
 iterations per Newton step, the Newton iterations, the contact force (which must not depend on the solver) and
 the CPU time of the FreeFEM processes for the whole run (the steadier figure on a shared machine). One row
-alone: ``python -m wendel.bench.petsc SCENE H SOLVER [PC [REUSE [RANKS [OPTIONS [ASSEMBLY]]]]]``.
+alone: ``python -m wendel.bench.petsc SCENE H SOLVER [PC [REUSE [RANKS [OPTIONS [ASSEMBLY [FORCING]]]]]]``.
 """
 
 from __future__ import annotations
@@ -26,7 +26,8 @@ DEFAULT_PC = "ml"
 
 
 def measure(scene_path: Path, out: Path, solver: str, pc: str = DEFAULT_PC, reuse: bool = True,
-            h: float | None = None, options: str = "", ranks: int = 1, assembly: str = "freefem") -> dict:
+            h: float | None = None, options: str = "", ranks: int = 1, assembly: str = "freefem",
+            forcing: str = "fixed") -> dict:
     """Run one scene with one solver; return its row (wall times per Newton step by phase, CPU time of the
     FreeFEM processes for the whole run: on a shared machine the steadier figure)."""
     scene = load(scene_path)
@@ -38,6 +39,7 @@ def measure(scene_path: Path, out: Path, solver: str, pc: str = DEFAULT_PC, reus
     scene.numerics.petsc.reuse = reuse
     scene.numerics.petsc.options = options
     scene.numerics.assembly = assembly
+    scene.numerics.forcing = forcing
     scene.output.png = False
     scene.output.vtu = False
     shutil.rmtree(out, ignore_errors=True)
@@ -50,7 +52,7 @@ def measure(scene_path: Path, out: Path, solver: str, pc: str = DEFAULT_PC, reus
     newton = max(s["newton_iterations"], 1)
     return {"scene": scene_path.stem, "h": scene.geometry.h, "dofs": s["dofs"],
             "solver": solver if solver != "petsc" else f"petsc-{pc}" + ("" if reuse else "-noreuse"), "ranks": ranks,
-            "assembly": assembly,
+            "assembly": assembly, "forcing": forcing,
             "newton_iterations": s["newton_iterations"],
             "krylov_per_step": last["linear_iterations"] / newton,
             "solve_s_per_step": ph["linear_solve"] / newton,
@@ -97,7 +99,7 @@ def petsc(quick: bool, workdir: Path) -> list[dict]:
 
 def main(argv: list[str] | None = None) -> None:
     """One row of the bench (each row is a run of up to a few minutes; the machine may be shared):
-    ``python -m wendel.bench.petsc SCENE H SOLVER [PC [REUSE [RANKS [OPTIONS [ASSEMBLY]]]]]``, e.g.
+    ``python -m wendel.bench.petsc SCENE H SOLVER [PC [REUSE [RANKS [OPTIONS [ASSEMBLY [FORCING]]]]]]``, e.g.
     ``python -m wendel.bench.petsc ball-indent 0.07 petsc ml``."""
     import sys
 
@@ -110,9 +112,11 @@ def main(argv: list[str] | None = None) -> None:
     ranks = int(a[5]) if len(a) > 5 else 1
     options = a[6] if len(a) > 6 else ""
     assembly = a[7] if len(a) > 7 else "freefem"
-    out = RESULTS / "bench" / "work" / "petsc-rows" / f"{scene}-h{h:g}-{solver}-{pc}-{int(reuse)}-np{ranks}-{assembly}"
+    forcing = a[8] if len(a) > 8 else "fixed"
+    out = (RESULTS / "bench" / "work" / "petsc-rows"
+           / f"{scene}-h{h:g}-{solver}-{pc}-{int(reuse)}-np{ranks}-{assembly}-{forcing}")
     r = measure(WORKFLOWS / f"{scene}.toml", out, solver, pc=pc, reuse=reuse, h=h, options=options, ranks=ranks,
-                assembly=assembly)
+                assembly=assembly, forcing=forcing)
     print(" ".join(f"{k}={v:.4g}" if isinstance(v, float) else f"{k}={v}" for k, v in r.items()))
 
 

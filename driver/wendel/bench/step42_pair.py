@@ -2,8 +2,10 @@
 
 deal.II: its own step-42 (Q1, one rank, global refinements: 5 = 107,811 DoFs; 4 = 14,739 with --quick) built
 from Debian's libdeal.ii-doc. wendel: workflows/ball-indent.toml at h = 0.05 (119,016 DoFs; 0.1 = 17,490 with
---quick) with PETSc-ML and the compiled element kernels (``numerics.assembly = "compiled"``). Order: deal.II,
-wendel, wendel, deal.II, so that a change of the machine's load during the run falls on both codes.
+--quick) with PETSc-ML and the compiled element kernels (``numerics.assembly = "compiled"``), its linear solves
+once to ``solver_tol`` in every Newton step (``forcing = "fixed"``) and once inexact (``forcing = "ew"``, the
+Eisenstat-Walker forcing term; the Newton tolerance is the same). Order: deal.II, wendel fixed, wendel ew,
+deal.II, so that a change of the machine's load during the run falls on both codes.
 
 Each row gives the whole-run wall time, the Newton steps, the time of the Newton steps' own work (deal.II: its
 TimerOutput sections "Assembling", "Residual and lambda" and "Solve"; wendel: assembly, constitutive update and
@@ -48,10 +50,11 @@ def _dealii_row(exe: Path, folder: Path, refinements: int) -> dict:
             "sections": sec}
 
 
-def _wendel_row(out: Path, h: float) -> dict:
-    r = measure(WORKFLOWS / "ball-indent.toml", out, "petsc", h=h, assembly="compiled")
+def _wendel_row(out: Path, h: float, forcing: str) -> dict:
+    r = measure(WORKFLOWS / "ball-indent.toml", out, "petsc", h=h, assembly="compiled", forcing=forcing)
     step = r["assembly_s_per_step"] + r["constitutive_s_per_step"] + r["solve_s_per_step"]
-    return {"code": "wendel (PETSc-ML, compiled kernels)", "dofs": r["dofs"],
+    return {"code": f"wendel (PETSc-ML, compiled kernels, forcing {forcing})", "dofs": r["dofs"],
+            "krylov_per_step": r["krylov_per_step"], "petsc_setups": r["petsc_setups"],
             "newton_iterations": r["newton_iterations"], "contact_force": r["contact_force"],
             "wall_time": r["wall_time"], "step_s": step, "us_per_newton_step_per_dof": 1e6 * step / r["dofs"]}
 
@@ -70,12 +73,12 @@ def ratios(rows: list[dict]) -> list[dict]:
 
 @register("step42-pair")
 def step42_pair(quick: bool, workdir: Path) -> list[dict]:
-    """deal.II step-42 and the wendel ball, interleaved D, W, W, D (see the module docstring)."""
+    """deal.II step-42 and the wendel ball, interleaved D, W (fixed), W (ew), D (see the module docstring)."""
     exe = _dealii_build(workdir)
     refinements, h = (4, 0.1) if quick else (5, 0.05)
     rows = [_dealii_row(exe, workdir / "dealii-0", refinements),
-            _wendel_row(workdir / "wendel-1", h),
-            _wendel_row(workdir / "wendel-2", h),
+            _wendel_row(workdir / "wendel-1", h, "fixed"),
+            _wendel_row(workdir / "wendel-2", h, "ew"),
             _dealii_row(exe, workdir / "dealii-3", refinements)]
     for r in rows:
         r.pop("sections", None)

@@ -68,6 +68,8 @@ def options(scene: Scene, files: RunFiles, dimension: int, segment: dict | None 
     segment = segment or {"mesh": "mesh.msh", "ubase": None, "eps0": None}
     opts = ["-mesh", str(files.root / segment["mesh"]), "-solver", n.solver, "-solver_tol", repr(n.solver_tol),
             "-newton_tol", repr(n.newton_tol), "-newton_maxit", str(n.newton_maxit)]
+    if n.forcing != "fixed":
+        opts += ["-solver_forcing", n.forcing]
     if n.solver == "petsc":
         opts += petsc.launch_options(n.petsc.pc, n.petsc.options, n.petsc.reuse)
     if scene.problem != "mechanics":

@@ -25,10 +25,10 @@ from ..scene import load
 from ..scene.reading import check_size
 from ..scene.schema import Scene
 from .checkpoint import RunFiles, State, committed, save as _save_checkpoint
-from . import overlap
+from . import overlap, separated
 from .guard import disk_full as _disk_full, guarded
 from .resume import is_drilling, restart, resume as resume_run, resume_drilling
-from .launch import entry_script, macros, options, write_tables
+from .launch import options, write_tables
 from .progress import _Progress
 from .steps import cut_step, grow_step, plan_step
 
@@ -124,6 +124,7 @@ def _solve_and_report(scene: Scene, files: RunFiles, state: State, dimension: in
         if scene.remesh and state.accepted and state.pending and not state.reequilibrate \
                 and not after_reequilibration:
             maybe_remesh(scene, files, state, dimension, progress)    # a run resumed before the decision
+        separated.maybe_switch(scene, files, state, dimension, progress)     # (the same, DG -> CG)
         solve(scene, files, state, dimension, progress)
         separation.after_run(scene, files, state, progress)
     finally:
@@ -176,22 +177,23 @@ def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress)
     write_tables(scene, files, dimension)
     if scene.remesh:            # imported while FreeFEM solves the first segment, not at the first remesh
         overlap.preload("wendel.remesh.transfer", "wendel.remesh.mesher")
-    entry = entry_script(scene, dimension)
-    switches = macros(scene, dimension)
     while state.pending:
         inc0 = state.last[0] + 1
+        seg = state.segment(inc0)
+        seg_scene, entry, switches, extra = separated.launch(scene, seg, dimension)    # CG after a DG separation
         if scene.loading.adaptive and not state.reequilibrate:
             plan_step(scene, state)
         was_reequilibration = state.reequilibrate
         batch, stop_args = remesh_batch.plan(scene, state, dimension)
+        if separated.watching(scene, state):
+            batch = batch[:1]           # the driver looks for a separation after every DG increment
         (files.fem / remesh_batch.STOP_FILE).unlink(missing_ok=True)
         loads = files.tables / "loads.txt"
         loads.write_text(f"{len(batch)}\n" + "".join(f"{lf!r}\n" for lf in batch))
-        seg = state.segment(inc0)
-        opts = options(scene, files, dimension, seg) + ["-loads", str(loads), "-inc0", str(inc0)]
+        opts = options(seg_scene, files, dimension, seg) + extra + ["-loads", str(loads), "-inc0", str(inc0)]
         if state.reequilibrate:
             opts += ["-restart", str(files.root / seg["state"]), "-relax_steps",
-                     str(state.remeshes[-1].get("relax_steps", scene.remesh.relax_steps))]
+                     str(state.remeshes[-1].get("relax_steps") or scene.remesh.relax_steps)]
         elif state.accepted:
             opts += ["-restart", str(files.fem / f"inc-{state.last[0]:04d}")]
         watcher = _Progress(files.fem, inc0, len(batch), batch, progress)
@@ -231,6 +233,7 @@ def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress)
         if scene.remesh and state.pending and not (was_reequilibration
                                                    and state.last[0] == state.segments[-1]["first"]):
             maybe_remesh(scene, files, state, dimension, progress)
+        separated.maybe_switch(scene, files, state, dimension, progress)
         _save_checkpoint(files, scene, state, dimension)
 
 
@@ -276,7 +279,7 @@ def accept(scene: Scene, files: RunFiles, state: State, dimension: int) -> None:
             vtu.write_vtu(files.vtu / f"inc-{inc:04d}.vtu", at, cells, dimension, pdata, cdata)
         state.accepted.append((inc, record["load_factor"]))
         state.pending.pop(0)
-        summary.append_history(files.root, {**record, **extra}, d / "newton.csv")
+        summary.append_history(files.root, separated.history_row(record, extra, seg), d / "newton.csv")
         _save_checkpoint(files, scene, state, dimension)
     if scene.output.vtu and state.accepted:
         vtu.write_pvd(files.root / "results.pvd",

@@ -6,7 +6,9 @@ label changes and at sharp corners (2D). The old physical tags (``meshes/labels.
 groups of the new mesh, which is written as MSH 2.2 (what FreeFEM's ``gmshload``/``gmshload3`` read).
 
 - 2D: the discrete curves get a piecewise-linear parametrization (``createGeometry``) and are meshed
-  again with the new size field; a plane surface is built on their curve loops. New boundary nodes lie
+  again with the new size field; a plane surface is built on the curve loops of each body
+  (:mod:`wendel.remesh.bodies`; a body cut along the boundary ``opened`` of a DG separation is glued,
+  meshed with the cut embedded and cut again there). New boundary nodes lie
   on the old (deformed) boundary polygon, so the domain is preserved exactly wherever the boundary is
   straight between corners, and to O(h^2 curvature) elsewhere.
 - 3D: the boundary triangulation is kept as it is (its nodes are the deformed old boundary nodes); the
@@ -30,10 +32,11 @@ from pathlib import Path
 import meshio
 import numpy as np
 
+from ..meshes import LABELS
 from ..meshes.builders import start_gmsh
-from . import quality
+from . import bodies, quality
 
-OPENED = 31       # meshes/labels.py: "opened", the faces a DG separation opened (separated.msh)
+OPENED = LABELS["opened"]      # the faces a DG separation opened (separated.msh)
 
 __all__ = ["remesh", "read_mesh", "boundary_facets"]
 
@@ -90,18 +93,18 @@ def _label_facets(bfacets, facets, facet_tags):
     return np.array([table.get(tuple(sorted(f)), 0) for f in bfacets.tolist()], dtype=np.int64)
 
 
-def _chains_2d(points, edges, labels, feature_angle):
+def _chains_2d(points, edges, labels, feature_angle, extra_corners=()):
     """Split the boundary edges into chains between corners: ``[(label, [n0, n1, ..., nk]), ...]``.
 
-    Corners are nodes where the label changes, where the boundary is not a simple curve, or where the
-    boundary turns by more than ``feature_angle`` degrees.
+    Corners are nodes where the label changes, where the boundary is not a simple curve, where the
+    boundary turns by more than ``feature_angle`` degrees, and ``extra_corners`` (ends of embedded curves).
     """
     out_edges = defaultdict(list)  # node -> edges leaving it
     in_edges = defaultdict(list)  # node -> edges arriving at it
     for k, (a, b) in enumerate(edges):
         out_edges[a].append(k)
         in_edges[b].append(k)
-    corners = set()
+    corners = set(extra_corners) & (set(out_edges) | set(in_edges))
     cos_max = np.cos(np.radians(feature_angle))
     for n in set(out_edges) | set(in_edges):
         if len(out_edges[n]) != 1 or len(in_edges[n]) != 1:
@@ -252,27 +255,34 @@ def remesh(points_deformed, mesh_in_path, out_path, h, size_indicator=None, h_mi
     if np.any(meas_old <= 0):
         raise ValueError(f"deformed mesh has {np.count_nonzero(meas_old <= 0)} inverted elements: "
                          "remesh from an earlier increment")
+    cut = None
+    if dim == 2 and OPENED in facet_tags:       # cut along opened faces: glued, meshed with the cut embedded
+        rep, cut = bodies.glue(points0, cells, facets, facet_tags, OPENED)
+        inside = {tuple(e) for e in cut.tolist()}
+        keep = np.array([not (t == OPENED and tuple(sorted(f)) in inside)
+                         for f, t in zip(rep[facets].tolist(), facet_tags.tolist())], dtype=bool)
+        facets, facet_tags, cells = rep[facets[keep]], facet_tags[keep], rep[cells]
+        pts = _mean_of_copies(pts, rep)
+        if np.any(quality.signed_measure(pts, cells) <= 0):
+            raise ValueError(f"{mesh_in_path}: the faces cut along '{OPENED}' have opened so far that the mesh "
+                             "glued at their mean position inverts: remesh from an earlier increment")
     bf = boundary_facets(cells)
     labels = _label_facets(bf, facets, facet_tags)
-    if OPENED in labels:
-        raise ValueError(f"{mesh_in_path}: the body is cut along opened faces (boundary 'opened', label {OPENED}, "
-                         "of a DG separation): remeshing it is not supported (gmsh does not finish meshing the two "
-                         "coincident sides of a cut); continue on this mesh without [remesh]")
     h_min = h / 4 if h_min is None else h_min
 
     start_gmsh()          # keeps the driver's Ctrl-C and SIGTERM handlers
     try:
         gmsh.model.add("remesh")
         groups = defaultdict(list)
-        if dim == 2:
-            surface = _model_2d(gmsh, pts, bf, labels, feature_angle, groups)
-            entity = surface
+        if dim == 2:     # one plane surface per body (several bodies, bodies cut along opened faces)
+            entities = bodies.model_2d(gmsh, pts, cells, bf, labels, feature_angle, groups, _chains_2d, _loops,
+                                       cut, OPENED)
         else:
-            entity = _model_3d(gmsh, pts, bf, labels, groups)
+            entities = [_model_3d(gmsh, pts, bf, labels, groups)]
         for lab, tags in sorted(groups.items()):
             g = gmsh.model.addPhysicalGroup(dim - 1, tags, lab)
             gmsh.model.setPhysicalName(dim - 1, g, _name(lab))
-        g = gmsh.model.addPhysicalGroup(dim, [entity], domain_label)
+        g = gmsh.model.addPhysicalGroup(dim, entities, domain_label)
         gmsh.model.setPhysicalName(dim, g, _name(domain_label))
 
         if size_indicator is None:
@@ -303,6 +313,8 @@ def remesh(points_deformed, mesh_in_path, out_path, h, size_indicator=None, h_mi
         etype = 2 if dim == 2 else 4
         _, conn = gmsh.model.mesh.getElementsByType(etype)
         new_cells = index[conn.astype(np.int64)].reshape(-1, dim + 1)
+        if len(new_cells) == 0:
+            raise ValueError(f"{mesh_in_path}: gmsh made no {_VOLUME[dim]}s from its boundary (see gmsh's log)")
         q = quality.mesh_quality(x, new_cells)
 
         gmsh.option.setNumber("Mesh.MshFileVersion", 2.2)
@@ -312,11 +324,15 @@ def remesh(points_deformed, mesh_in_path, out_path, h, size_indicator=None, h_mi
         gmsh.write(str(out_path))
     finally:
         gmsh.finalize()
+    if cut is not None:     # open the new mesh along the embedded curves again
+        from ..results.separation import reopen
+        x, new_cells = reopen(out_path)
     return {
         "path": out_path,
         "dimension": dim,
         "nodes": len(x),
         "elements": len(new_cells),
+        "bodies": int(bodies.body_index(new_cells).max()) + 1 if dim == 2 else 1,
         "boundary_labels": sorted(int(k) for k in groups),
         "domain_label": domain_label,
         "unlabelled_facets": int(np.count_nonzero(labels == 0)),
@@ -329,6 +345,17 @@ def remesh(points_deformed, mesh_in_path, out_path, h, size_indicator=None, h_mi
     }
 
 
+def _mean_of_copies(pts, rep):
+    """Every vertex at the mean position of the copies merged into its representative ``rep``."""
+    out = pts.copy()
+    total = np.zeros_like(pts)
+    np.add.at(total, rep, pts)
+    count = np.bincount(rep, minlength=len(pts)).astype(float)
+    merged = count > 1
+    out[merged] = total[merged] / count[merged, None]
+    return out
+
+
 def _name(label):
     try:
         from ..meshes.labels import NAMES
@@ -338,37 +365,6 @@ def _name(label):
         except ImportError:
             NAMES = {}
     return NAMES.get(label, f"label{label}")
-
-
-def _model_2d(gmsh, pts, edges, labels, feature_angle, groups):
-    """Discrete points and curves of the boundary, re-parametrized; a plane surface on their loops."""
-    chains = _chains_2d(pts[:, :2], edges.tolist(), labels, feature_angle)
-    corners = sorted({c[1][0] for c in chains} | {c[1][-1] for c in chains})
-    for node in corners:
-        gmsh.model.addDiscreteEntity(0, node + 1)
-        gmsh.model.mesh.addNodes(0, node + 1, [node + 1], pts[node].tolist())
-    for i, (lab, nodes) in enumerate(chains):
-        tag = i + 1
-        gmsh.model.addDiscreteEntity(1, tag, [nodes[0] + 1, nodes[-1] + 1])
-        inner = np.asarray(nodes[1:-1], dtype=np.int64)
-        if len(inner):
-            gmsh.model.mesh.addNodes(1, tag, (inner + 1).tolist(), pts[inner].ravel().tolist())
-        seg = np.column_stack([nodes[:-1], nodes[1:]]) + 1
-        gmsh.model.mesh.addElementsByType(tag, 1, [], seg.ravel().tolist())
-        groups[lab].append(tag)
-    gmsh.model.mesh.createGeometry()
-    loops = _loops(chains)
-
-    def signed_area(loop):
-        ring = np.concatenate([chains[j][1][:-1] for j in loop])
-        x, y = pts[ring, 0], pts[ring, 1]
-        return 0.5 * np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y)
-
-    loops.sort(key=lambda lp: -abs(signed_area(lp)))  # the outer boundary first, then the holes
-    wires = [gmsh.model.geo.addCurveLoop([j + 1 for j in lp]) for lp in loops]
-    surface = gmsh.model.geo.addPlaneSurface(wires)
-    gmsh.model.geo.synchronize()
-    return surface
 
 
 def _model_3d(gmsh, pts, faces, labels, groups):

@@ -138,7 +138,7 @@ def remesh_state(inc_dir: Path, mesh_old: Path, ubase_old: np.ndarray | None, di
         fields.append(("qp", f.name, transfer.cell_to_nodes(xd, cells, qp_cells[f.name], axisymmetric=axisymmetric)))
     widths = [a.reshape(n_old, -1).shape[1] for _, _, a in fields]
     stacked = np.hstack([a.reshape(n_old, -1) for _, _, a in fields])
-    moved, outside = transfer.transfer_nodal(xd, cells, stacked, Y)
+    moved, outside = transfer.transfer_nodal(xd, cells, stacked, _targets(mesh_new, Y, new_cells, dimension))
     report["nodes_outside_old_mesh"] = int(outside)
     vtu.write_array(state_new / "u.node.txt", np.zeros(len(Y) * dimension))
     vol_old, vol_new = cell_volumes(xd, cells, axisymmetric), cell_volumes(Y, new_cells, axisymmetric)
@@ -180,6 +180,17 @@ def remesh_state(inc_dir: Path, mesh_old: Path, ubase_old: np.ndarray | None, di
             shutil.copyfile(f, state_new / f.name)
     report["transfer_seconds"] = time.perf_counter() - t1
     return report
+
+
+def _targets(mesh: Path, Y: np.ndarray, cells: np.ndarray, dimension: int) -> np.ndarray:
+    """Where the new nodes are located in the old mesh: a node on a cut (boundary ``opened``) a hair inside its
+    own cells (:func:`wendel.remesh.bodies.inside_targets`), the others where they are."""
+    if dimension != 2:
+        return Y
+    from . import bodies, mesher
+
+    *_, facets, tags = mesher.read_mesh(mesh)
+    return bodies.inside_targets(Y, cells, np.unique(facets[tags == mesher.OPENED]))
 
 
 @contextlib.contextmanager

@@ -76,8 +76,12 @@ def split(points: np.ndarray, tris: np.ndarray, mids: np.ndarray):
 
     Returns (points, triangles, opened boundary segments (n, 2) in the new numbering, body index per triangle).
     """
+    return cut(points, tris, open_edges(points, tris, mids))
+
+
+def cut(points: np.ndarray, tris: np.ndarray, cut: set[tuple[int, int]]):
+    """Cut the triangle mesh along the interior edges ``cut`` (sorted vertex pairs): :func:`split`'s result."""
     owners = _edges(tris)
-    cut = open_edges(points, tris, mids)
     # per vertex: its triangles fall into groups joined through the edges at it that stay closed
     at: dict[int, list[int]] = {}
     for t, tri in enumerate(tris.tolist()):
@@ -118,39 +122,15 @@ def split(points: np.ndarray, tris: np.ndarray, mids: np.ndarray):
     return np.array(new_points), new_tris, opened, np.array([order[r] for r in roots], dtype=int)
 
 
-def write_separated(mesh_path: Path, inc_dir: Path, out: Path) -> dict:
-    """``out`` (MSH 2.2): the mesh of ``mesh_path`` cut along the faces opened by increment ``inc_dir``.
-
-    Returns what it wrote: bodies and their areas (m^2), opened segments and their length (m)."""
-    import meshio
-
-    from .vtu import read_array
-
-    m = meshio.read(mesh_path, file_format="gmsh")
-    tris = np.concatenate([b.data for b in m.cells if b.type == "triangle"])
-    tri_tags = np.concatenate([m.cell_data["gmsh:physical"][i] for i, b in enumerate(m.cells) if b.type == "triangle"])
-    mids = read_array(inc_dir / "dg_open_faces.txt").reshape(-1, 2)
-    points, new_tris, opened, body = split(m.points, tris, mids)
-    # the scene's boundary segments, renumbered through the triangle that owns each
-    owners = _edges(tris)
-    lines, line_tags = [], []
-    for i, b in enumerate(m.cells):
-        if b.type != "line":
-            continue
-        for (a, c), tag in zip(b.data.tolist(), m.cell_data["gmsh:physical"][i].tolist()):
-            t = owners[(min(a, c), max(a, c))][0]
-            pos = {v: k for k, v in enumerate(tris[t].tolist())}
-            lines.append((new_tris[t][pos[a]], new_tris[t][pos[c]]))
-            line_tags.append(tag)
-    names = {(int(v[0]), int(v[1])): k for k, v in m.field_data.items()}      # (tag, dimension) -> name
-    if LABELS[OPENED] in {int(t) for t in line_tags}:
-        raise ValueError(f"{mesh_path}: already has the boundary '{OPENED}' (label {LABELS[OPENED]})")
+def write_msh(out: Path, points, tris, tri_tags, lines, line_tags, opened, names: dict) -> None:
+    """MSH 2.2 of a cut triangle mesh: the boundary segments ``lines`` (tags ``line_tags``), both sides of the
+    cut (``opened``, label 31) and the triangles; ``names``: (tag, dimension) -> physical name."""
     physical = [(1, t, names[(t, 1)]) for t in sorted({int(t) for t in line_tags}) if (t, 1) in names]
     physical += [(1, LABELS[OPENED], OPENED)]
     physical += [(2, t, names[(t, 2)]) for t in sorted({int(t) for t in tri_tags}) if (t, 2) in names]
-    elements = [(1, LABELS[OPENED], s) for s in opened.tolist()] + \
+    elements = [(1, LABELS[OPENED], s) for s in np.asarray(opened).tolist()] + \
         [(1, int(tag), s) for s, tag in zip(lines, line_tags)] + \
-        [(2, int(tag), t) for t, tag in zip(new_tris.tolist(), tri_tags.tolist())]
+        [(2, int(tag), t) for t, tag in zip(np.asarray(tris).tolist(), np.asarray(tri_tags).tolist())]
     with open(out, "w") as f:
         f.write("$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$PhysicalNames\n")
         f.write(f"{len(physical)}\n" + "".join(f'{d} {t} "{n}"\n' for d, t, n in physical))
@@ -161,6 +141,80 @@ def write_separated(mesh_path: Path, inc_dir: Path, out: Path) -> dict:
             kind = 1 if dim == 1 else 2
             f.write(f"{i + 1} {kind} 2 {tag} {tag} " + " ".join(str(n + 1) for n in nodes) + "\n")
         f.write("$EndElements\n")
+
+
+def _read_tri_mesh(mesh_path: Path):
+    """(mesh, points, triangles, their tags, boundary lines [(a, b)], their tags, (tag, dim) -> name)."""
+    import meshio
+
+    m = meshio.read(mesh_path, file_format="gmsh")
+    tris = np.concatenate([b.data for b in m.cells if b.type == "triangle"])
+    tri_tags = np.concatenate([m.cell_data["gmsh:physical"][i] for i, b in enumerate(m.cells) if b.type == "triangle"])
+    lines, line_tags = [], []
+    for i, b in enumerate(m.cells):
+        if b.type == "line":
+            lines += [tuple(e) for e in b.data.tolist()]
+            line_tags += [int(t) for t in m.cell_data["gmsh:physical"][i].tolist()]
+    names = {(int(v[0]), int(v[1])): k for k, v in m.field_data.items()}
+    return m.points, tris, tri_tags, lines, line_tags, names
+
+
+def _renumber_lines(tris, new_tris, lines):
+    """Boundary segments of the uncut mesh in the numbering of the cut one (through the triangle owning each)."""
+    owners = _edges(tris)
+    out = []
+    for a, c in lines:
+        t = owners[(min(a, c), max(a, c))][0]
+        pos = {v: k for k, v in enumerate(tris[t].tolist())}
+        out.append((new_tris[t][pos[a]], new_tris[t][pos[c]]))
+    return out
+
+
+def reopen(mesh_path: Path):
+    """Cut the mesh file along its segments labelled ``opened`` (interior edges, e.g. curves gmsh embedded) and
+    write it back with both sides of the cut as ``opened``; returns (points, triangles) of the cut mesh."""
+    points, tris, tri_tags, lines, line_tags, names = _read_tri_mesh(mesh_path)
+    label = LABELS[OPENED]
+    edges = {(min(a, b), max(a, b)) for (a, b), t in zip(lines, line_tags) if t == label}
+    new_points, new_tris, opened, _ = cut(points, tris, edges)
+    rest = [(e, t) for e, t in zip(lines, line_tags) if t != label]
+    write_msh(mesh_path, new_points, new_tris, tri_tags, _renumber_lines(tris, new_tris, [e for e, _ in rest]),
+              [t for _, t in rest], opened, names)
+    return new_points, new_tris
+
+
+def keep_held(mesh_path: Path, out: Path, held: set[int]) -> tuple[np.ndarray, np.ndarray]:
+    """``out``: the cut mesh of ``mesh_path`` without the bodies that touch no boundary labelled in ``held``
+    (a body that nothing holds has no static equilibrium); returns which triangles were kept and the old
+    numbers of the vertices kept, in their new order."""
+    points, tris, tri_tags, lines, line_tags, names = _read_tri_mesh(mesh_path)
+    _, _, _, body = cut(points, tris, set())
+    owner = {e: ts[0] for e, ts in _edges(tris).items()}
+    line_body = [body[owner[(min(a, b), max(a, b))]] for a, b in lines]
+    kept_bodies = {k for k, t in zip(line_body, line_tags) if t in held}
+    keep = np.isin(body, sorted(kept_bodies))
+    label = LABELS[OPENED]
+    used = np.unique(tris[keep])
+    new = np.full(len(points), -1)
+    new[used] = np.arange(len(used))
+    rest = [((new[a], new[b]), t) for (a, b), t, k in zip(lines, line_tags, line_body) if k in kept_bodies]
+    write_msh(out, points[used], new[tris[keep]], np.asarray(tri_tags)[keep], [e for e, t in rest if t != label],
+              [t for _, t in rest if t != label], [e for e, t in rest if t == label], names)
+    return keep, used
+
+
+def write_separated(mesh_path: Path, inc_dir: Path, out: Path) -> dict:
+    """``out`` (MSH 2.2): the mesh of ``mesh_path`` cut along the faces opened by increment ``inc_dir``.
+
+    Returns what it wrote: bodies and their areas (m^2), opened segments and their length (m)."""
+    from .vtu import read_array
+
+    points0, tris, tri_tags, lines, line_tags, names = _read_tri_mesh(mesh_path)
+    mids = read_array(inc_dir / "dg_open_faces.txt").reshape(-1, 2)
+    points, new_tris, opened, body = split(points0, tris, mids)
+    if LABELS[OPENED] in set(line_tags):
+        raise ValueError(f"{mesh_path}: already has the boundary '{OPENED}' (label {LABELS[OPENED]})")
+    write_msh(out, points, new_tris, tri_tags, _renumber_lines(tris, new_tris, lines), line_tags, opened, names)
     p2 = points[:, :2]
     nb = int(body.max()) + 1
     e1, e2 = p2[new_tris[:, 1]] - p2[new_tris[:, 0]], p2[new_tris[:, 2]] - p2[new_tris[:, 0]]
@@ -169,7 +223,7 @@ def write_separated(mesh_path: Path, inc_dir: Path, out: Path) -> dict:
     report = {"increment": int(inc_dir.name.split("-")[-1]), "opened_faces": len(mids),
               "opened_segments": len(opened), "opened_length": float(seg.sum() / 2),
               "bodies": nb, "body_areas": [float(area[body == k].sum()) for k in range(nb)],
-              "duplicated_vertices": len(points) - len(m.points)}
+              "duplicated_vertices": len(points) - len(points0)}
     out.with_suffix(".json").write_text(json.dumps(report, indent=1))
     return report
 
@@ -177,8 +231,8 @@ def write_separated(mesh_path: Path, inc_dir: Path, out: Path) -> dict:
 def after_run(scene, files, state, progress) -> None:
     """A separating DG run: separated.msh, the mesh cut along the faces opened by the last increment."""
     dg = getattr(scene, "discretization", None)
-    if dg is None or dg.separation_stress <= 0 or not state.accepted:
-        return
+    if dg is None or dg.separation_stress <= 0 or not state.accepted or state.segments[-1].get("discretization"):
+        return          # (a run gone on with CG wrote it when it switched: wendel.loop.separated)
     inc = state.last[0]
     rep = write_separated(files.root / state.segment(inc)["mesh"], files.fem / f"inc-{inc:04d}",
                           files.root / "separated.msh")

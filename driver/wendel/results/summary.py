@@ -16,6 +16,7 @@ import shutil
 import socket
 import subprocess
 import sys
+import threading
 import time
 from importlib import metadata
 from pathlib import Path
@@ -44,22 +45,50 @@ def _freefem_version() -> str:
 
 
 def write_provenance(root: Path, scene_path: Path, scene, smoke: bool) -> None:
-    """The scene as run and where it ran: commit, versions, command line, host, start time."""
+    """The scene as run and where it ran: commit, versions, command line, host, start time.
+
+    The commit and the package versions (two git and one dpkg-query process, seven package metadata parsed:
+    0.17 s, a seventh of a smoke run, issue 20) are looked up in a thread while the run meshes and solves;
+    provenance.json is written at once without them (a resumed run needs its ``smoke``), then again with
+    them. :func:`write_summary` waits for the thread (:func:`provenance_done`)."""
     # first and atomically: a run stopped before its first checkpoint restarts from it (wendel run --resume)
     tmp = root / "scene.resolved.json.tmp"
     tmp.write_text(json.dumps(scene.model_dump(mode="json"), indent=1))
     os.replace(tmp, root / "scene.resolved.json")
     shutil.copyfile(scene_path, root / "scene.toml")
-    versions = {"wendel": __version__, "python": sys.version.split()[0], "freefem++": _freefem_version()}
-    for pkg in ("gmsh", "meshio", "numpy", "scipy", "pydantic", "pyvista", "matplotlib"):
-        try:
-            versions[pkg] = metadata.version(pkg)
-        except metadata.PackageNotFoundError:
-            versions[pkg] = "missing"
-    prov = {"git_commit": _git_commit(), "versions": versions, "command": sys.argv, "smoke": smoke,
-            "host": socket.gethostname(), "platform": platform.platform(), "cpus": os.cpu_count(),
-            "start": time.strftime("%Y-%m-%dT%H:%M:%S%z")}
-    (root / "provenance.json").write_text(json.dumps(prov, indent=1))
+    prov = {"command": sys.argv, "smoke": smoke, "host": socket.gethostname(), "platform": platform.platform(),
+            "cpus": os.cpu_count(), "start": time.strftime("%Y-%m-%dT%H:%M:%S%z")}
+    _write_json(root / "provenance.json", prov)
+
+    def lookup() -> None:
+        versions = {"wendel": __version__, "python": sys.version.split()[0], "freefem++": _freefem_version()}
+        for pkg in ("gmsh", "meshio", "numpy", "scipy", "pydantic", "pyvista", "matplotlib"):
+            try:
+                versions[pkg] = metadata.version(pkg)
+            except metadata.PackageNotFoundError:
+                versions[pkg] = "missing"
+        _write_json(root / "provenance.json", {"git_commit": _git_commit(), "versions": versions, **prov})
+
+    thread = threading.Thread(target=lookup, name="wendel-provenance", daemon=True)
+    _LOOKUPS[root.resolve()] = thread
+    thread.start()
+
+
+_LOOKUPS: dict[Path, threading.Thread] = {}
+"""The provenance look-up of each run folder still running (:func:`write_provenance`)."""
+
+
+def provenance_done(root: Path) -> None:
+    """Wait until the run's provenance.json holds the commit and the versions."""
+    thread = _LOOKUPS.pop(root.resolve(), None)
+    if thread is not None:
+        thread.join()
+
+
+def _write_json(path: Path, data: dict) -> None:
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(json.dumps(data, indent=1))
+    os.replace(tmp, path)
 
 
 def append_history(root: Path, record: dict, newton_csv: Path) -> None:
@@ -67,6 +96,9 @@ def append_history(root: Path, record: dict, newton_csv: Path) -> None:
     hist = root / "history.csv"
     keys = [k for k, v in record.items() if isinstance(v, (int, float))]
     new = not hist.exists() or hist.stat().st_size == 0   # created empty by a run stopped in this instant
+    if not new:      # the columns of the first row (a run that changes its modules, loop/separated.py, keeps them)
+        with open(hist, newline="") as f:
+            keys = next(csv.reader(f), keys)
     with open(hist, "a", newline="") as f:
         w = csv.DictWriter(f, fieldnames=keys, extrasaction="ignore")
         if new:
@@ -168,10 +200,11 @@ def write_summary(root: Path, scene, state, dimension: int, picture: float | Non
     if (root / "stopped.json").is_file():
         summary["stopped"] = json.loads((root / "stopped.json").read_text())
     prov_path = root / "provenance.json"
+    provenance_done(root)
     if prov_path.is_file():
         prov = json.loads(prov_path.read_text())
         prov["end"] = time.strftime("%Y-%m-%dT%H:%M:%S%z")
-        prov_path.write_text(json.dumps(prov, indent=1))
+        _write_json(prov_path, prov)
     tmp = root / "summary.json.tmp"
     tmp.write_text(json.dumps(summary, indent=1))
     os.replace(tmp, root / "summary.json")

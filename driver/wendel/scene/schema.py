@@ -175,8 +175,8 @@ class Petsc(Strict):
     pc: PcName = Field("ml", description=f"preconditioner: {', '.join(PRECONDITIONERS)}")
     options: str = Field("", description="more PETSc options, \"-name value\" pairs (e.g. \"-ksp_rtol 1e-8\"); "
                          "they override the preset; no option that reads or writes files")
-    reuse: bool = Field(True, description="keep the preconditioner across Newton steps and increments while "
-                        "the iterations stay below 1.5x those right after its setup")
+    reuse: bool = Field(True, description="keep the preconditioner across Newton steps and increments until "
+                        "the iterations it costs beyond a fresh one's add up to its setup time")
 
     @field_validator("options")
     @classmethod
@@ -191,6 +191,10 @@ class Numerics(Strict):
     solver: SolverName = Field("direct", description=f"linear solver: {', '.join(SOLVERS)}")
     solver_tol: float = Field(1e-10, gt=0, lt=1, description="relative residual of iterative solvers [1]")
     newton_tol: float = Field(1e-9, gt=0, lt=1, description="relative Newton residual [1]")
+    forcing: Literal["fixed", "ew"] = Field("fixed", description="tolerance of the Newton steps' iterative "
+                                            "solves (cg, petsc): fixed = solver_tol; ew = an inexact Newton, "
+                                            "Eisenstat-Walker's forcing term (0.1 at most, no tighter than the "
+                                            "Newton tolerance needs); the Newton tolerance is unchanged")
     newton_maxit: int = Field(25, ge=1, le=500, description="Newton iterations per increment")
     timeout: float = Field(3600.0, gt=0, description="wall-time limit of one FreeFEM launch [s]")
     petsc: Petsc = Field(default_factory=Petsc, description="PETSc solver settings (solver = \"petsc\")")
@@ -206,6 +210,8 @@ class Numerics(Strict):
         if self.ranks > 1 and self.solver not in ("ffddm", "petsc"):
             raise ValueError(f"solver {self.solver!r} runs on one rank; use solver = \"ffddm\" or \"petsc\" "
                              f"with ranks = {self.ranks}")
+        if self.forcing != "fixed" and self.solver not in ("cg", "petsc"):
+            raise ValueError(f"forcing = {self.forcing!r} needs an iterative solver: solver = \"cg\" or \"petsc\"")
         return self
 
 

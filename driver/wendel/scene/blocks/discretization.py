@@ -39,6 +39,9 @@ class Discretization(BaseModel):
                                 "|F|/|K| [1]; same bound")
     separation_stress: float = Field(0.0, ge=0, le=1e15, description="dg: an interior face whose normal stress "
                                      "(mean of its two elements) exceeds this opens for good [Pa]; 0 = never")
+    after_separation: Literal["dg", "cg"] = Field("dg", description="dg with separation_stress in 2D: 'cg' goes "
+                                                  "on with CG on the remeshed bodies once the opened faces cut "
+                                                  "the body into two or more (boundary 'opened', free)")
     region: Optional[list[list[float]]] = Field(None, description="dg in 2D: only the cells whose centre lies in "
                                                 "this box [[x0, y0], [x1, y1]] are DG, the others CG, coupled by "
                                                 "Nitsche terms (elastic) [m]")
@@ -75,7 +78,12 @@ def check(block: Discretization, scene) -> None:
             raise ValueError("discretization.separation_stress needs discretization.kind = 'dg'")
         if block.region is not None:
             raise ValueError("discretization.region needs discretization.kind = 'dg'")
+        if block.after_separation != "dg":
+            raise ValueError("discretization.after_separation needs discretization.kind = 'dg'")
         return
+    if block.after_separation == "cg" and (block.separation_stress <= 0 or getattr(scene, "plasticity", None)):
+        raise ValueError("discretization.after_separation = 'cg' needs separation_stress > 0 and an elastic scene "
+                         "(the plastic state is not carried from DG to CG)")
     if block.region is not None and (getattr(scene, "plasticity", None) is not None or block.separation_stress > 0):
         raise ValueError("discretization.region (CG and DG in one mesh) is elastic only, without separation_stress")
     others = [n for n in scene.blocks if n not in ("discretization", "plasticity")]
