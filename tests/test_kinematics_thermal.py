@@ -309,15 +309,3 @@ def test_transient_coupled_square_agrees_with_small_strain_to_the_strain_order(t
     assert np.abs(ul[2]["u"] - ss[2]["u"]).max() < 3e-3 * np.abs(ss[2]["u"]).max()
     assert np.abs(ul[1]["vonMises"] - ss[1]["vonMises"]).max() < 3e-3 * ss[1]["vonMises"].max()
 
-
-def test_thermal_expansion_with_contact_in_the_current_configuration_is_refused_by_the_check(scene_file):
-    """thermo-indent.toml (ball, alpha > 0) with updated-Lagrangian kinematics: its ball would take friction.idp's
-    contact, which has no thermal-expansion rows; `wendel check` exits 2 naming the key (FreeFEM used to stop
-    in the run)."""
-    import subprocess
-    import sys
-
-    path = scene_file((WORKFLOWS / "thermo-indent.toml").read_text() + '\n[kinematics]\nkind = "updated-lagrangian"\n')
-    out = subprocess.run([sys.executable, "-m", "wendel.cli", "check", str(path)], capture_output=True, text=True)
-    assert out.returncode == 2, out.stdout + out.stderr
-    assert "thermal.alpha > 0 with [contact]" in out.stdout + out.stderr and "Traceback" not in out.stderr

@@ -387,13 +387,6 @@ class SceneBase(Strict):
             if th is not None and th.source_kind in ("manufactured", "moving"):
                 raise ValueError(f"kinematics.kind = \"updated-lagrangian\" is not implemented with a {th.source_kind} "
                                  "heat source (its position and exact fields are those of the launch mesh)")
-            ct = getattr(self, "contact", None)
-            if th is not None and th.alpha > 0 and ct is not None:
-                from .blocks.contact import in_current_configuration
-                if in_current_configuration(ct, self):
-                    raise ValueError("thermal.alpha > 0 with [contact] under kinematics.kind = \"updated-lagrangian\": "
-                                     "the contact in the current configuration (friction.idp) does not take thermal "
-                                     "expansion (its (u, T) coupling rows are not rotated into the contact frames)")
             if self.elasticity.plane == "stress":
                 raise ValueError("kinematics.kind = \"updated-lagrangian\" needs elasticity.plane = \"strain\" "
                                  "or \"axisymmetric\"")
