@@ -20,8 +20,10 @@
 //   options  PETSc options, "-name value" tokens (checked by the caller; lib/solver.idp adds its presets).
 //            Besides PETSc's own: -wendel_pc_reuse 0|1 (default 1): keep the preconditioner of an earlier
 //            matrix with the same pattern, rebuilt when the iterations it has cost beyond those of a fresh one
-//            (at the convergence rate of the solve right after its setup) add up to more than its setup time,
-//            or when a solve on it fails.
+//            (at the convergence rate of the solve right after its setup) add up to more than
+//            -wendel_pc_setup_its N (default 20: an ML setup measured as ~20 of its iterations on the
+//            step-42 ball), or when a solve on it fails. Counts, not measured times: a run takes the same
+//            path on a busy and on a quiet machine, and every rank decides alike.
 //   info     output, resized to 6: iterations, true relative residual ||b - A x|| / ||b||, KSP converged
 //            reason (> 0 converged), 1 if the preconditioner was reused, seconds in CSR + setup, seconds
 //            in the Krylov solve.
@@ -69,8 +71,8 @@ struct Cache {
     PetscMPIInt size = 1;
     bool reuse = true;
     double rateAtSetup = 0;                    // digits of residual reduction per iteration after the setup
-    double setupCost = 0;                      // s, the last setup of the preconditioner
-    double extraCost = 0;                      // s, iterations beyond the setup's rate since then (kept one)
+    double setupIts = 20;                      // -wendel_pc_setup_its: a setup's cost in Krylov iterations
+    double extraIts = 0;                       // iterations beyond the setup's rate since then (kept one)
     bool stale = true;                         // rebuild the preconditioner at the next solve
 };
 Cache cache;
@@ -249,6 +251,9 @@ PetscErrorCode setupSolver(const KN<double>& coords, long bs)
     PetscBool reuse = PETSC_TRUE, set = PETSC_FALSE;
     PetscCall(PetscOptionsGetBool(NULL, NULL, "-wendel_pc_reuse", &reuse, &set));
     cache.reuse = reuse;
+    PetscReal setupIts = 20;
+    PetscCall(PetscOptionsGetReal(NULL, NULL, "-wendel_pc_setup_its", &setupIts, &set));
+    cache.setupIts = setupIts;
     PetscFunctionReturn(0);
 }
 
@@ -327,18 +332,14 @@ PetscErrorCode solve(Matrice_Creuse<double>* K, KN<double>* b, KN<double>* x, KN
         double digits = (rnorm > 0 && bnorm > 0) ? std::log10(bnorm / rnorm) : 0;
         if (!reused) {
             cache.rateAtSetup = its > 0 ? digits / its : 0;
-            cache.setupCost = t2 - t1;
-            cache.extraCost = 0;
+            cache.extraIts = 0;
             cache.stale = false;
             break;
         }
         if (reason > 0) {
             double fresh = cache.rateAtSetup > 0 ? digits / cache.rateAtSetup : 0;
-            if (its > 0 && its > fresh) cache.extraCost += (its - fresh) * (t3 - t2) / its;
-            int stale = cache.extraCost > cache.setupCost;                // set up anew at the next solve
-            if (cache.size > 1)                // times differ between ranks: the setup is collective, decide together
-                PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &stale, 1, MPI_INT, MPI_MAX, PETSC_COMM_WORLD));
-            if (stale) cache.stale = true;
+            if (its > 0 && its > fresh) cache.extraIts += its - fresh;
+            if (cache.extraIts > cache.setupIts) cache.stale = true;      // set up anew at the next solve
             break;
         }
         cache.stale = true;                                               // the kept one failed: set up and solve again

@@ -176,7 +176,8 @@ class Petsc(Strict):
     options: str = Field("", description="more PETSc options, \"-name value\" pairs (e.g. \"-ksp_rtol 1e-8\"); "
                          "they override the preset; no option that reads or writes files")
     reuse: bool = Field(True, description="keep the preconditioner across Newton steps and increments until "
-                        "the iterations it costs beyond a fresh one's add up to its setup time")
+                        "the iterations it costs beyond a fresh one's add up to a setup's cost in iterations "
+                        "(PETSc option -wendel_pc_setup_its, default 20)")
 
     @field_validator("options")
     @classmethod
