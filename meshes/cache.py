@@ -11,7 +11,8 @@ An entry is a folder ``DIR/<key>/`` with ``mesh.msh`` and ``meta.json`` (the :cl
 sha256 of the mesh). A hit copies the mesh into place after checking its sha256; a corrupt entry is rebuilt
 with a warning, never used. A miss builds into place and stores the entry atomically: the folder is written
 under a temporary name in DIR and renamed, so two processes building one key at once leave one valid
-entry (the loser's rename fails and its copy is dropped). Without the variable nothing changes.
+entry (the loser's rename fails and its copy is dropped). ``<mesh>.cache.json`` next to the mesh says hit or
+miss and the key (summary.json's ``mesh_cache``). Without the variable nothing changes.
 
 >>> len(key("box", {"h": 0.1, "lengths": (1, 2)})) == 64
 True
@@ -131,12 +132,24 @@ def build(name: str, path: Path, params: dict, make):
         path.write_bytes(data)
         if _digest(path.read_bytes()) != meta["sha256"]:
             raise OSError(f"mesh cache: copy of {entry / 'mesh.msh'} to {path} differs from the entry")
-        return Built(path, meta["dimension"], list(meta["boundaries"]), meta["nodes"], meta["elements"],
-                     cache={"dir": str(root), "key": k, "hit": True})
+        return _record(Built(path, meta["dimension"], list(meta["boundaries"]), meta["nodes"], meta["elements"]),
+                       root, k, True)
     built = make(path, **params)
     meta = {"builder": name, "params": params, "gmsh": gmsh_version(), "source": source_hash(),
             "sha256": _digest(Path(built.path).read_bytes()), "dimension": built.dimension,
             "boundaries": list(built.boundaries), "nodes": built.nodes, "elements": built.elements}
     _store(entry, Path(built.path), meta)
-    built.cache = {"dir": str(root), "key": k, "hit": False}
+    return _record(built, root, k, False)
+
+
+def _record(built, root: Path, k: str, hit: bool):
+    """Say where the mesh came from: in ``built.cache`` and in ``<mesh>.cache.json`` next to the mesh (a run's
+    summary.json reads it)."""
+    built.cache = {"dir": str(root), "key": k, "hit": hit}
+    sidecar(Path(built.path)).write_text(json.dumps(built.cache))
     return built
+
+
+def sidecar(mesh: Path) -> Path:
+    """The file next to ``mesh`` that says whether it came from the cache."""
+    return mesh.with_name(mesh.name + ".cache.json")

@@ -162,8 +162,6 @@ def build(scene: Scene, files: RunFiles) -> tuple[float, int]:
     if g.builder:
         built = build_mesh(g.builder, files.mesh, **g.params)
         dimension = built.dimension
-        if built.cache is not None:     # WENDEL_MESH_CACHE: summary.json says hit or miss and the key
-            (files.root / "mesh_cache.json").write_text(json.dumps(built.cache))
     else:
         shutil.copyfile(g.mesh, files.mesh)
         dimension = g.dimension
