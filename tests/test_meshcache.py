@@ -112,3 +112,14 @@ def test_a_run_gives_the_same_results_with_a_cold_and_a_warm_cache(tmp_path, mon
     assert reference["fields"] and reference["history"]
     assert _fingerprint(cold) == reference
     assert _fingerprint(warm) == reference
+
+
+def test_the_mesh_cache_option_of_wendel_run(tmp_path, monkeypatch, capsys):
+    from wendel.cli import main
+
+    monkeypatch.setenv(ENV, "")              # restored after the test: the option sets the variable for good
+    for n in ("a", "b"):
+        assert main(["run", str(WORKFLOWS / "smoke.toml"), "--smoke", "--out", str(tmp_path / n),
+                     "--mesh-cache", str(tmp_path / "cache")]) == 0
+    hits = [json.loads((tmp_path / n / "summary.json").read_text())["mesh_cache"]["hit"] for n in ("a", "b")]
+    assert hits == [False, True] and len(_entries(tmp_path / "cache")) == 1
