@@ -27,6 +27,8 @@ class Built:
     boundaries: list[str]
     nodes: int
     elements: int
+    # from the mesh cache (wendel.meshes.cache): {"dir", "key", "hit"}; None when the cache is off
+    cache: dict | None = None
 
 
 def register(name: str, boundaries: list[str] | Callable[..., list[str]] | None = None):
@@ -46,10 +48,13 @@ def register(name: str, boundaries: list[str] | Callable[..., list[str]] | None 
 
 
 def build(name: str, path: Path, **params) -> Built:
-    """Run builder ``name`` and write its mesh to ``path`` (MSH 2.2)."""
+    """Run builder ``name`` and write its mesh to ``path`` (MSH 2.2), through the mesh cache when
+    ``WENDEL_MESH_CACHE`` is set (:mod:`wendel.meshes.cache`)."""
     if name not in BUILDERS:
         raise KeyError(f"unknown geometry builder {name!r}; valid: {', '.join(sorted(BUILDERS))}")
-    return BUILDERS[name](Path(path), **params)
+    from . import cache
+
+    return cache.build(name, Path(path), params, BUILDERS[name])
 
 
 def start_gmsh():

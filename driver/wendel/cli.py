@@ -8,11 +8,16 @@ Only what a command needs is imported: ``wendel check`` and ``wendel keys`` neve
 from __future__ import annotations
 
 import argparse
+import os
 import signal
 import sys
 from pathlib import Path
 
 from . import __version__
+
+
+MESH_CACHE_HELP = ("reuse the initial meshes of earlier runs from this folder (content-addressed; "
+                   "also WENDEL_MESH_CACHE=DIR)")
 
 
 def ranks_option(text: str) -> int:
@@ -51,10 +56,12 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--smoke", action="store_true", help="run at the scene's tiny smoke size")
     p.add_argument("--out", type=Path, help="run folder (default results/<scene>/<time>)")
     p.add_argument("--resume", type=Path, metavar="RUN_DIR", help="continue a run from its last checkpoint")
+    p.add_argument("--mesh-cache", type=Path, metavar="DIR", help=MESH_CACHE_HELP)
 
     p = sub.add_parser("study", help="error against run time over refined meshes")
     p.add_argument("scene")
     p.add_argument("--levels", type=int, default=3, help="number of meshes (h, h/2, ...)")
+    p.add_argument("--mesh-cache", type=Path, metavar="DIR", help=MESH_CACHE_HELP)
     p.add_argument("--smoke", action="store_true", help="start from the smoke size")
     p.add_argument("--np", type=ranks_option)
     p.add_argument("--out", type=Path)
@@ -79,7 +86,7 @@ def main(argv: list[str] | None = None) -> int:
                    "  necking (Simo's necking bar on 3 meshes, with and without F-bar),\n"
                    "  oxley, oxley-domain, oxley-kienzle (the analytic orthogonal cut);\n"
                    "only when named: step42-dealii, step42-pair (deal.II and wendel interleaved, about 8 minutes),\n"
-                   "  overhead, gmsh3d,\n"
+                   "  overhead, gmsh3d, meshcache (the ball with a cold and a warm mesh cache, about 3 minutes),\n"
                    "  cutting, cutting-isothermal (the FE orthogonal cut, about 15 minutes each),\n"
                    "  cutting-mesh (the FE cut at 3 edge resolutions and 2 steps, about an hour), cutting-fbar,\n"
                    "  cutting-steady (the FE cut to 1.2 mm, about 20 minutes),\n"
@@ -90,8 +97,11 @@ def main(argv: list[str] | None = None) -> int:
     p = sub.add_parser("sweep", help="campaigns: a plan of runs, locally or on SLURM (see wendel.sweep)")
     from .sweep.cli import add_arguments as sweep_arguments
     sweep_arguments(p)
+    p.add_argument("--mesh-cache", type=Path, metavar="DIR", help=MESH_CACHE_HELP)
 
     args = parser.parse_args(argv)
+    if getattr(args, "mesh_cache", None):     # inherited by a sweep's runs (local and SLURM)
+        os.environ["WENDEL_MESH_CACHE"] = str(args.mesh_cache.resolve())
     if args.command == "run" and args.resume is None and args.scene:
         _prestart_picture(Path(args.scene))
     from .errors import DiskFull, Interrupted, StepCutError
