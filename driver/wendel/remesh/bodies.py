@@ -27,23 +27,33 @@ from __future__ import annotations
 import numpy as np
 
 
-def body_index(cells: np.ndarray) -> np.ndarray:
-    """Connected components of triangles through shared edges (vertex indices): a body index per cell."""
+def components(faces: np.ndarray, labels: np.ndarray | None = None) -> np.ndarray:
+    """Connected components of triangles (cells, or boundary faces of a 3D mesh) through shared edges, joined only
+    where the two triangles have the same label (all alike without ``labels``): a component index per triangle."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
-    cells = np.asarray(cells)
-    edges = np.sort(np.concatenate([cells[:, [0, 1]], cells[:, [1, 2]], cells[:, [2, 0]]]), axis=1)
-    owner = np.tile(np.arange(len(cells)), 3)
+    faces = np.asarray(faces)
+    labels = np.ones(len(faces), dtype=np.int64) if labels is None else np.asarray(labels)
+    edges = np.concatenate([np.sort(faces[:, [i, j]], axis=1) for i, j in ((0, 1), (1, 2), (2, 0))])
+    owner = np.tile(np.arange(len(faces)), 3)
     _, eid = np.unique(edges, axis=0, return_inverse=True)
     eid = eid.ravel()
     order = np.argsort(eid, kind="stable")
-    e, f = eid[order], owner[order]
-    same = e[1:] == e[:-1]
-    g = coo_matrix((np.ones(int(same.sum())), (f[:-1][same], f[1:][same])), shape=(len(cells), len(cells)))
-    _, lab = connected_components(g, directed=False)
+    e_sorted, f_sorted = eid[order], owner[order]
+    same = e_sorted[1:] == e_sorted[:-1]
+    a, b = f_sorted[:-1][same], f_sorted[1:][same]
+    keep = labels[a] == labels[b]
+    a, b = a[keep], b[keep]
+    g = coo_matrix((np.ones(len(a)), (a, b)), shape=(len(faces), len(faces)))
+    return connected_components(g, directed=False)[1]
+
+
+def body_index(cells: np.ndarray) -> np.ndarray:
+    """Connected components of triangles through shared edges (vertex indices): a body index per cell, numbered
+    in the order of their first cell."""
     first = {}
-    return np.array([first.setdefault(int(v), len(first)) for v in lab], dtype=np.int64)
+    return np.array([first.setdefault(int(v), len(first)) for v in components(cells)], dtype=np.int64)
 
 
 def _area(pts, ring):

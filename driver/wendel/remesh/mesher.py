@@ -166,33 +166,12 @@ def _loops(chains):
 
 def _shells(faces):
     """Connected components (through shared edges) of boundary faces: a component index per face."""
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-
-    return _components(faces, np.ones(len(faces), dtype=np.int64), coo_matrix, connected_components)
-
-
-def _components(faces, labels, coo_matrix, connected_components):
-    edges = np.concatenate([np.sort(faces[:, [i, j]], axis=1) for i, j in ((0, 1), (1, 2), (2, 0))])
-    owner = np.tile(np.arange(len(faces)), 3)
-    _, eid = np.unique(edges, axis=0, return_inverse=True)
-    eid = eid.ravel()
-    order = np.argsort(eid, kind="stable")
-    e_sorted, f_sorted = eid[order], owner[order]
-    same = e_sorted[1:] == e_sorted[:-1]
-    a, b = f_sorted[:-1][same], f_sorted[1:][same]
-    keep = labels[a] == labels[b]
-    a, b = a[keep], b[keep]
-    g = coo_matrix((np.ones(len(a)), (a, b)), shape=(len(faces), len(faces)))
-    return connected_components(g, directed=False)[1]
+    return bodies.components(faces)
 
 
 def _patches(faces, labels):
     """Connected pieces of equally labelled boundary faces: a patch index per face."""
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-
-    return _components(faces, labels, coo_matrix, connected_components)
+    return bodies.components(faces, labels)
 
 
 def _size_view(gmsh, points, cells, sizes):
