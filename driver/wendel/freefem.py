@@ -48,8 +48,6 @@ def read_json(text: str) -> dict:
     >>> read_json('{"residual": -nan, "r": inf, "s": -inf}')
     {'residual': nan, 'r': inf, 's': -inf}
     """
-    import re
-
     text = re.sub(r"(:\s*)-?nan\b", r"\1NaN", text)
     return json.loads(re.sub(r"(:\s*)(-?)inf\b", r"\1\2Infinity", text))
 

@@ -89,7 +89,7 @@ def maybe_switch(scene, files, state, dimension: int, progress) -> bool:
 
 def switch(scene, files, state, dimension: int, progress) -> None:
     """Separated mesh, remesh, transfer; the next segment is CG from the same load factor."""
-    from ..remesh.step import remesh_state
+    from ..remesh.step import cell_volumes, remesh_state
 
     inc, lf = state.last
     inc_dir = files.fem / f"inc-{inc:04d}"
@@ -110,7 +110,7 @@ def switch(scene, files, state, dimension: int, progress) -> None:
             v = vtu.read_array(f)
             vtu.write_array(pseudo / f.name, v.reshape(len(cells), -1)[keep])
     shutil.copyfile(inc_dir / "record.json", pseudo / "record.json")
-    area = vtu_area(points, cells)
+    area = cell_volumes(points[:, :2], cells)
     rep_sep.update({"dropped_pieces": int(rep_sep["bodies"] - len(np.unique(_bodies(cells)[keep]))),
                     "dropped_area": float(area[~keep].sum())})
     (files.root / "separated.json").write_text(json.dumps(rep_sep, indent=1))
@@ -139,12 +139,6 @@ def _bodies(cells):
     from ..remesh.bodies import body_index
 
     return body_index(cells)
-
-
-def vtu_area(points, cells):
-    p = np.asarray(points)[:, :2]
-    e1, e2 = p[cells[:, 1]] - p[cells[:, 0]], p[cells[:, 2]] - p[cells[:, 0]]
-    return 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
 
 
 def cut_displacement(u_dg: np.ndarray, cells: np.ndarray, n_points: int) -> np.ndarray:

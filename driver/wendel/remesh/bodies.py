@@ -26,6 +26,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..results.separation import edge_owners
+
 
 def components(faces: np.ndarray, labels: np.ndarray | None = None) -> np.ndarray:
     """Connected components of triangles (cells, or boundary faces of a 3D mesh) through shared edges, joined only
@@ -74,16 +76,8 @@ def glue(points, cells, facets, facet_tags, label):
     _, first, inverse = np.unique(points[on, :2], axis=0, return_index=True, return_inverse=True)
     rep[on] = on[first[inverse.ravel()]]
     cut = np.unique(np.sort(rep[facets[facet_tags == label]], axis=1), axis=0)
-    owners = _edge_count(rep[np.asarray(cells)])
-    return rep, cut[np.array([owners.get(tuple(e), 0) == 2 for e in cut.tolist()], dtype=bool).reshape(-1)]
-
-
-def _edge_count(cells):
-    count: dict[tuple[int, int], int] = {}
-    for tri in np.asarray(cells).tolist():
-        for a, b in ((tri[0], tri[1]), (tri[1], tri[2]), (tri[2], tri[0])):
-            count[(min(a, b), max(a, b))] = count.get((min(a, b), max(a, b)), 0) + 1
-    return count
+    owners = edge_owners(rep[np.asarray(cells)])
+    return rep, cut[np.array([len(owners.get(tuple(e), ())) == 2 for e in cut.tolist()], dtype=bool).reshape(-1)]
 
 
 def model_2d(gmsh, pts, cells, edges, labels, feature_angle, groups, chains_2d, loops_of, cut=None, cut_label=0):
@@ -119,16 +113,11 @@ def model_2d(gmsh, pts, cells, edges, labels, feature_angle, groups, chains_2d, 
     out = [gmsh.model.geo.addPlaneSurface([gmsh.model.geo.addCurveLoop(w) for w in wires]) for wires in surfaces]
     gmsh.model.geo.synchronize()
     if len(cut):
-        owner = _edge_owner(cells)
+        owners = edge_owners(np.asarray(cells))
         for (a, _b), tag in zip([(nodes[0], nodes[1]) for _, nodes in cut_chains], cut_tags):
-            b = body[owner[(min(a, _b), max(a, _b))]]
+            b = body[owners[(min(a, _b), max(a, _b))][0]]       # both cells of a cut edge are in one body
             gmsh.model.mesh.embed(1, [tag], 2, out[b])
     return out
-
-
-def _edge_owner(cells):
-    return {(min(a, b), max(a, b)): c for c, tri in enumerate(np.asarray(cells).tolist())
-            for a, b in ((tri[0], tri[1]), (tri[1], tri[2]), (tri[2], tri[0]))}
 
 
 def _cut_chains(cut, boundary_nodes, points, feature_angle):

@@ -42,7 +42,7 @@ class _Union:
         self.parent[self.find(a)] = self.find(b)
 
 
-def _edges(tris: np.ndarray) -> dict[tuple[int, int], list[int]]:
+def edge_owners(tris: np.ndarray) -> dict[tuple[int, int], list[int]]:
     """Sorted vertex pair -> the triangles that have it."""
     owners: dict[tuple[int, int], list[int]] = {}
     for t, (a, b, c) in enumerate(tris.tolist()):
@@ -55,7 +55,7 @@ def open_edges(points: np.ndarray, tris: np.ndarray, mids: np.ndarray) -> set[tu
     """The interior edges whose midpoints are ``mids`` (n, 2); an unmatched midpoint is an error."""
     from scipy.spatial import cKDTree
 
-    owners = _edges(tris)
+    owners = edge_owners(tris)
     keys = list(owners)
     if len(mids) == 0:
         return set()
@@ -81,7 +81,7 @@ def split(points: np.ndarray, tris: np.ndarray, mids: np.ndarray):
 
 def cut(points: np.ndarray, tris: np.ndarray, cut: set[tuple[int, int]]):
     """Cut the triangle mesh along the interior edges ``cut`` (sorted vertex pairs): :func:`split`'s result."""
-    owners = _edges(tris)
+    owners = edge_owners(tris)
     # per vertex: its triangles fall into groups joined through the edges at it that stay closed
     at: dict[int, list[int]] = {}
     for t, tri in enumerate(tris.tolist()):
@@ -161,7 +161,7 @@ def _read_tri_mesh(mesh_path: Path):
 
 def _renumber_lines(tris, new_tris, lines):
     """Boundary segments of the uncut mesh in the numbering of the cut one (through the triangle owning each)."""
-    owners = _edges(tris)
+    owners = edge_owners(tris)
     out = []
     for a, c in lines:
         t = owners[(min(a, c), max(a, c))][0]
@@ -189,7 +189,7 @@ def keep_held(mesh_path: Path, out: Path, held: set[int]) -> tuple[np.ndarray, n
     numbers of the vertices kept, in their new order."""
     points, tris, tri_tags, lines, line_tags, names = _read_tri_mesh(mesh_path)
     _, _, _, body = cut(points, tris, set())
-    owner = {e: ts[0] for e, ts in _edges(tris).items()}
+    owner = {e: ts[0] for e, ts in edge_owners(tris).items()}
     line_body = [body[owner[(min(a, b), max(a, b))]] for a, b in lines]
     kept_bodies = {k for k, t in zip(line_body, line_tags) if t in held}
     keep = np.isin(body, sorted(kept_bodies))

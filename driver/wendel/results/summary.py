@@ -52,9 +52,7 @@ def write_provenance(root: Path, scene_path: Path, scene, smoke: bool) -> None:
     provenance.json is written at once without them (a resumed run needs its ``smoke``), then again with
     them. :func:`write_summary` waits for the thread (:func:`provenance_done`)."""
     # first and atomically: a run stopped before its first checkpoint restarts from it (wendel run --resume)
-    tmp = root / "scene.resolved.json.tmp"
-    tmp.write_text(json.dumps(scene.model_dump(mode="json"), indent=1))
-    os.replace(tmp, root / "scene.resolved.json")
+    _write_json(root / "scene.resolved.json", scene.model_dump(mode="json"))
     shutil.copyfile(scene_path, root / "scene.toml")
     prov = {"command": sys.argv, "smoke": smoke, "host": socket.gethostname(), "platform": platform.platform(),
             "cpus": os.cpu_count(), "start": time.strftime("%Y-%m-%dT%H:%M:%S%z")}
@@ -207,9 +205,7 @@ def write_summary(root: Path, scene, state, dimension: int, picture: float | Non
         prov = json.loads(prov_path.read_text())
         prov["end"] = time.strftime("%Y-%m-%dT%H:%M:%S%z")
         _write_json(prov_path, prov)
-    tmp = root / "summary.json.tmp"
-    tmp.write_text(json.dumps(summary, indent=1))
-    os.replace(tmp, root / "summary.json")
+    _write_json(root / "summary.json", summary)
     return summary
 
 
