@@ -15,11 +15,10 @@ import os
 import shutil
 from pathlib import Path
 
+from ..meshes.cache import ENV
 from . import register
 from .step42 import _dealii_build
 from .step42_pair import _dealii_row, _wendel_row
-
-ENV = "WENDEL_MESH_CACHE"
 
 
 def _cached_row(out: Path, h: float, cache: Path) -> dict:

@@ -195,8 +195,10 @@ def write_summary(root: Path, scene, state, dimension: int, picture: float | Non
         "warnings": warnings(state, scene),
         "last_increment": last,
     }
-    if (root / "mesh.msh.cache.json").is_file():      # the mesh came from (or went into) WENDEL_MESH_CACHE
-        summary["mesh_cache"] = json.loads((root / "mesh.msh.cache.json").read_text())
+    from ..meshes.cache import sidecar
+
+    if sidecar(root / "mesh.msh").is_file():      # the mesh came from (or went into) WENDEL_MESH_CACHE
+        summary["mesh_cache"] = json.loads(sidecar(root / "mesh.msh").read_text())
     if (root / "stopped.json").is_file():
         summary["stopped"] = json.loads((root / "stopped.json").read_text())
     prov_path = root / "provenance.json"
