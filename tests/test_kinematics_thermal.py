@@ -69,6 +69,21 @@ newton_tol = 1e-12
 png = false
 """
 
+# the plane-strain square on its symmetry planes (left, bottom)
+SQUARE = """[geometry]
+builder = "rectangle"
+x = [0.0, 0.1]           # m
+y = [0.0, 0.1]           # m
+h = 0.05                 # m
+[boundary.left]
+ux = 0.0                 # m
+[boundary.bottom]
+uy = 0.0                 # m
+"""
+# steady: the outer edges (right, top) held at 1293.15 K, 2 increments
+HOT_EDGES = ("[thermal.boundary.right]\ntemperature = 1293.15   # K\n"
+             "[thermal.boundary.top]\ntemperature = 1293.15     # K\n" + NUMERICS.format(steps=2))
+
 FREE = {
     # 3D cube on symmetry planes, transient: heated by a uniform source (1000 K in 1 s without the
     # Gough-Joule cooling), insulated, 4 increments, monolithic
@@ -89,35 +104,15 @@ uz = 0.0                 # m
            + "source = 3.588e9           # W/m^3: rho c 1000 K / 1 s\n" + NUMERICS.format(steps=4), 3, 2e-5),
     # plane-strain square on symmetry planes, steady, every other edge at 1293.15 K, staggered
     "plane": ("""description = "UL free thermal expansion, plane strain"
-[geometry]
-builder = "rectangle"
-x = [0.0, 0.1]           # m
-y = [0.0, 0.1]           # m
-h = 0.05                 # m
-[boundary.left]
-ux = 0.0                 # m
-[boundary.bottom]
-uy = 0.0                 # m
-""" + MATERIAL + THERMAL.format(alpha=ALPHA, coupling="staggered", duration=0.0)
-              + "[thermal.boundary.right]\ntemperature = 1293.15   # K\n"
-              + "[thermal.boundary.top]\ntemperature = 1293.15     # K\n" + NUMERICS.format(steps=2), 2, ALPHA),
+""" + SQUARE + MATERIAL + THERMAL.format(alpha=ALPHA, coupling="staggered", duration=0.0)
+              + HOT_EDGES, 2, ALPHA),
     # the same with perfect plasticity: sigma_zz = -E alpha dT would be 80 sigma0, so the body flows
     "plane-plastic": ("""description = "UL free thermal expansion, plane strain, perfectly plastic"
-[geometry]
-builder = "rectangle"
-x = [0.0, 0.1]           # m
-y = [0.0, 0.1]           # m
-h = 0.05                 # m
-[boundary.left]
-ux = 0.0                 # m
-[boundary.bottom]
-uy = 0.0                 # m
-[plasticity]
+""" + SQUARE + """[plasticity]
 law = "perfect"
 sigma0 = 250e6           # Pa
 """ + MATERIAL + THERMAL.format(alpha=ALPHA, coupling="monolithic", duration=0.0)
-              + "[thermal.boundary.right]\ntemperature = 1293.15   # K\n"
-              + "[thermal.boundary.top]\ntemperature = 1293.15     # K\n" + NUMERICS.format(steps=2), 2, ALPHA),
+              + HOT_EDGES, 2, ALPHA),
     # (r, z) cylinder on its symmetry plane, steady, outer surface and top at 1293.15 K, monolithic
     "axi": ("""description = "UL free thermal expansion, (r, z) cylinder"
 [geometry]
@@ -130,8 +125,7 @@ plane = "axisymmetric"
 [boundary.bottom]
 uy = 0.0                 # m
 """ + MATERIAL + THERMAL.format(alpha=ALPHA, coupling="monolithic", duration=0.0)
-            + "[thermal.boundary.right]\ntemperature = 1293.15   # K\n"
-            + "[thermal.boundary.top]\ntemperature = 1293.15     # K\n" + NUMERICS.format(steps=2), 2, ALPHA),
+            + HOT_EDGES, 2, ALPHA),
 }
 
 
