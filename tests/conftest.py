@@ -34,6 +34,21 @@ def quiet():
     return lines.append
 
 
+def smoke_ball(out: Path, **numerics) -> Path:
+    """Run step-42's ball (workflows/ball-indent.toml, contact + J2 plasticity, 3D) at its smoke size with the
+    ``[numerics]`` keys given, without picture and VTU; return the run folder."""
+    from wendel.loop import run_scene
+    from wendel.scene import load
+
+    path = WORKFLOWS / "ball-indent.toml"
+    scene = load(path, smoke=True)
+    for key, value in numerics.items():
+        setattr(scene.numerics, key, value)
+    scene.output.png = False
+    scene.output.vtu = False
+    return run_scene(scene, path, out, smoke=True, progress=lambda *_: None)
+
+
 def edit(text: str, old: str, new: str) -> str:
     """``text`` with its first ``old`` replaced by ``new`` (which must be there: a test edits what it means to)."""
     assert old in text, old

@@ -11,20 +11,11 @@ import sys
 
 import pytest
 
-from wendel.loop import run_scene
-from wendel.scene import load
-
-from conftest import WORKFLOWS
+from conftest import WORKFLOWS, smoke_ball
 
 
 def solve(solver: str, forcing: str, out) -> dict:
-    path = WORKFLOWS / "ball-indent.toml"
-    scene = load(path, smoke=True)
-    scene.numerics.solver = solver
-    scene.numerics.forcing = forcing
-    scene.output.png = False
-    scene.output.vtu = False
-    root = run_scene(scene, path, out, smoke=True, progress=lambda *_: None)
+    root = smoke_ball(out, solver=solver, forcing=forcing)
     return json.loads((root / "summary.json").read_text()) | {"root": root}
 
 

@@ -11,22 +11,13 @@ import sys
 import numpy as np
 import pytest
 
-from wendel.loop import run_scene
 from wendel.results.vtu import read_array
-from wendel.scene import load
 
-from conftest import WORKFLOWS
+from conftest import WORKFLOWS, smoke_ball
 
 
 def ball(out, assembly: str, solver: str = "cg", ranks: int = 1) -> tuple[dict, np.ndarray]:
-    path = WORKFLOWS / "ball-indent.toml"
-    scene = load(path, smoke=True)
-    scene.numerics.solver = solver
-    scene.numerics.ranks = ranks
-    scene.numerics.assembly = assembly
-    scene.output.png = False
-    scene.output.vtu = False
-    root = run_scene(scene, path, out, smoke=True, progress=lambda *_: None)
+    root = smoke_ball(out, solver=solver, ranks=ranks, assembly=assembly)
     u = read_array(sorted(root.glob("fem/inc-*/u.node.txt"))[-1])
     return json.loads((root / "summary.json").read_text()), u
 
