@@ -123,3 +123,21 @@ def test_the_mesh_cache_option_of_wendel_run(tmp_path, monkeypatch, capsys):
                      "--mesh-cache", str(tmp_path / "cache")]) == 0
     hits = [json.loads((tmp_path / n / "summary.json").read_text())["mesh_cache"]["hit"] for n in ("a", "b")]
     assert hits == [False, True] and len(_entries(tmp_path / "cache")) == 1
+
+
+def test_box_without_netgen_is_another_valid_mesh_under_another_key(tmp_path, monkeypatch):
+    """geometry.optimize = false (box): gmsh's tetrahedra without the Netgen optimization: the same boundaries,
+    another mesh (so another cache key), every tetrahedron of positive volume."""
+    monkeypatch.setenv(ENV, str(tmp_path / "cache"))
+    opt = build("box", tmp_path / "opt.msh", **BOX)
+    raw = build("box", tmp_path / "raw.msh", **BOX, optimize=False)
+    assert raw.boundaries == opt.boundaries and raw.dimension == 3 and raw.elements > 0
+    assert raw.cache["key"] != opt.cache["key"]
+    assert (tmp_path / "raw.msh").read_bytes() != (tmp_path / "opt.msh").read_bytes()
+    import meshio
+    import numpy as np
+
+    m = meshio.read(tmp_path / "raw.msh")
+    p, t = m.points, m.cells_dict["tetra"]
+    vol = np.einsum("ij,ij->i", np.cross(p[t[:, 1]] - p[t[:, 0]], p[t[:, 2]] - p[t[:, 0]]), p[t[:, 3]] - p[t[:, 0]]) / 6
+    assert np.all(np.abs(vol) > 0) and abs(np.abs(vol).sum() - 0.25) < 1e-12     # the box's volume, m^3

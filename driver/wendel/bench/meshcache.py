@@ -21,11 +21,11 @@ from .step42 import _dealii_build
 from .step42_pair import _dealii_row, _wendel_row
 
 
-def _cached_row(out: Path, h: float, cache: Path) -> dict:
+def _cached_row(out: Path, h: float, cache: Path, **scene) -> dict:
     old = os.environ.get(ENV)
     os.environ[ENV] = str(cache)
     try:
-        row = _wendel_row(out, h, "ew")
+        row = _wendel_row(out, h, "ew", **scene)
     finally:
         if old is None:
             os.environ.pop(ENV, None)

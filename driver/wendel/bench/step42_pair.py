@@ -50,8 +50,8 @@ def _dealii_row(exe: Path, folder: Path, refinements: int) -> dict:
             "sections": sec}
 
 
-def _wendel_row(out: Path, h: float, forcing: str) -> dict:
-    r = measure(WORKFLOWS / "ball-indent.toml", out, "petsc", h=h, assembly="compiled", forcing=forcing)
+def _wendel_row(out: Path, h: float, forcing: str, scene: Path = WORKFLOWS / "ball-indent.toml") -> dict:
+    r = measure(scene, out, "petsc", h=h, assembly="compiled", forcing=forcing)
     step = r["assembly_s_per_step"] + r["constitutive_s_per_step"] + r["solve_s_per_step"]
     return {"code": f"wendel (PETSc-ML, compiled kernels, forcing {forcing})", "dofs": r["dofs"],
             "krylov_per_step": r["krylov_per_step"], "petsc_setups": r["petsc_setups"],
