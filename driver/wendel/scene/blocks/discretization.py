@@ -31,7 +31,7 @@ class Discretization(BaseModel):
     model_config = ConfigDict(extra="forbid", validate_assignment=True)
 
     kind: Literal["cg", "dg"] = Field("cg", description="cg: continuous Lagrange (elasticity.order); dg: "
-                                      "interior penalty with Nitsche boundaries (2D; 3D linear elastic)")
+                                      "interior penalty with Nitsche boundaries (2D, 3D; elastic or J2 plastic)")
     order: int = Field(1, ge=1, le=2, description="polynomial degree of the DG displacement (P1dc, P2dc) [1]")
     gamma_mu: float = Field(20.0, gt=0, le=1e6, description="penalty on the jump, times 2 mu |F|/|K| [1]; "
                             "sufficient: 6 (P1), 18 (P2) in 2D, 8 and 21.3 in 3D")
@@ -71,8 +71,8 @@ def penalty_warnings(block: Discretization, dimension: int) -> list[str]:
 
 
 def check(block: Discretization, scene) -> None:
-    """DG joins plasticity (P1, P2; separation P1 only); plane 2D or 3D (3D: no separation, no region); direct solver, no remesh,
-    no prescribed motion."""
+    """DG joins plasticity (P1 and P2; separation with plasticity P1 only); plane 2D or 3D (3D: no separation, no
+    region); direct solver, no remesh, no prescribed motion."""
     if block.kind != "dg":
         if block.separation_stress > 0:
             raise ValueError("discretization.separation_stress needs discretization.kind = 'dg'")
