@@ -120,7 +120,8 @@ def test_dg_plasticity_follows_hill_with_newton_converging_fast(tmp_path, quiet)
     assert 0 < err_dg < 0.15 and err_dg < sc["errors"]["error_plastic_radius"], (sd["errors"], sc["errors"])
 
 
-def test_a_killed_dg_plastic_run_resumes_to_the_same_result(tmp_path):
+@pytest.mark.parametrize("scene_name", ["cylinder-dg.toml", "cylinder-dg-p2.toml"])
+def test_a_killed_dg_plastic_run_resumes_to_the_same_result(tmp_path, scene_name):
     import signal
     import subprocess
     import sys
@@ -131,7 +132,7 @@ def test_a_killed_dg_plastic_run_resumes_to_the_same_result(tmp_path):
     from wendel.results.vtu import read_array
 
     cmd = [sys.executable, "-m", "wendel.cli", "run"]
-    scene = str(WORKFLOWS / "cylinder-dg.toml")
+    scene = str(WORKFLOWS / scene_name)
     assert subprocess.run(cmd + [scene, "--smoke", "--out", str(tmp_path / "ref")], capture_output=True).returncode == 0
     killed = tmp_path / "killed"
     p = subprocess.Popen(cmd + [scene, "--smoke", "--out", str(killed)], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
