@@ -60,8 +60,6 @@ def test_a_penalty_below_the_stability_bound_is_warned_about_and_spoils_the_solu
 @pytest.mark.parametrize("change, message", [
     (("[discretization]", "[thermal]\nk = 50.0\nrho = 7800.0\nc = 460.0\nalpha = 1.2e-5\nduration = 1.0\n\n[discretization]"),
      "elastic and plastic scenes only; remove [thermal]"),
-    (("[discretization]\nkind = \"dg\"\norder = 1 ", "[plasticity]\nsigma0 = 1.0\n\n[discretization]\nkind = \"dg\"\n"
-      "separation_stress = 1e6\norder = 2 "), "separation_stress with [plasticity] needs discretization.order = 1"),
     (("solver = \"direct\"", "solver = \"ffddm\""), "numerics.solver = 'direct'"),
     (("order = 1                # P1dc", "order = 3"), "discretization.order"),
     (("gamma_mu = 20.0 ", "gamma_mu = -1.0 "), "discretization.gamma_mu"),

@@ -1,7 +1,8 @@
 """J2 plasticity with P2 discontinuous Galerkin (edp/lib/dg-plastic-p2.idp), 2D and 3D: the return mapping at
 the P2 rule's points and the face stress the P1 field through them. Far from yield it is P2dc elasticity to
 round-off; Hill's cylinder is followed more closely than with P1dc; the face tangent is the exact derivative of
-the face forces (central differences at every tangent, -dg_fd_check) and Newton converges quadratically."""
+the face forces (central differences at every tangent, -dg_fd_check) and Newton converges quadratically; a
+notched plate yields, then separates."""
 
 from __future__ import annotations
 
@@ -114,7 +115,8 @@ def test_p2_dg_plasticity_in_3d_has_an_exact_tangent_and_converges_quadratically
 def test_p2_dg_plasticity_in_3d_gives_cgs_uniform_state(tmp_path, scene_file, quiet):
     # uniaxial tension of a cube past yield (uniaxial-linear.toml, homogeneous, linear hardening): DG P2 with its
     # 4 points per tetrahedron reaches CG P1's state (measured to 1e-13 relative), in the same Newton iterations
-    uni = edit((WORKFLOWS / "uniaxial-linear.toml").read_text(), "newton_tol = 1e-10", "newton_tol = 1e-10\nsolver = \"direct\"")
+    uni = edit((WORKFLOWS / "uniaxial-linear.toml").read_text(), "newton_tol = 1e-10",
+               "newton_tol = 1e-10\nsolver = \"direct\"")
     dg = "\n[discretization]\nkind = \"dg\"\norder = 2\ngamma_mu = 25.0\ngamma_lambda = 25.0\n"
     roots = {k: run(scene_file(uni + extra, f"uni-{k}.toml"), smoke=True, out=tmp_path / k, progress=quiet)
              for k, extra in (("cg", ""), ("dg", dg))}
@@ -124,3 +126,34 @@ def test_p2_dg_plasticity_in_3d_gives_cgs_uniform_state(tmp_path, scene_file, qu
     for a, b in zip(rows["cg"], rows["dg"]):
         for key in ("strain_energy", "max_plastic_strain", "max_von_mises"):
             assert float(b[key]) == pytest.approx(float(a[key]), rel=1e-10), key
+
+
+SEPARATION = [("order = 1                # P1dc", "order = 2"), ("[smoke]\nh = 0.1 ", "[smoke]\nh = 0.2 "),
+              ("steps = 10", "steps = 5"), ("uy = 4e-3 ", "uy = 2e-3 ")]
+
+
+def test_p2_dg_plasticity_separates(tmp_path, scene_file, quiet):
+    # the notched plate of dg-separation.toml with P2 (h = 0.2 m, to 2 mm): far from yield the faces open as in the
+    # elastic run (measured: the same faces and Newton iterations, support forces to 1e-13); at sigma0 = 250 MPa
+    # the notch yields first, then faces open and the plate separates (measured: plastic strain 1.9e-4 before any
+    # opening, 3 then 6 faces open, support force 1.26e8 -> 9.7e7 -> 7e-6 N/m, two bodies)
+    text = (WORKFLOWS / "dg-separation.toml").read_text()
+    for change in SEPARATION:
+        text = edit(text, *change)
+    plastic = lambda s0: edit(text, "[boundary.bottom]",
+                              f"[plasticity]\nlaw = \"perfect\"\nsigma0 = {s0}\n\n[boundary.bottom]")
+    rows = {}
+    for k, t in (("elastic", text), ("far", plastic("1e14")), ("plastic", plastic("250e6"))):
+        root = run(scene_file(t, f"{k}.toml"), smoke=True, out=tmp_path / k, png=False, progress=quiet)
+        rows[k] = list(csv.DictReader((root / "history.csv").open()))
+    for a, b in zip(rows["elastic"], rows["far"]):
+        assert a["newton_iterations"] == b["newton_iterations"] and a["dg_open_faces"] == b["dg_open_faces"]
+        assert float(b["dg_reaction_y"]) == pytest.approx(float(a["dg_reaction_y"]), rel=1e-9)
+    assert int(float(rows["elastic"][-1]["dg_open_faces"])) > 0
+    p = rows["plastic"]
+    opened = [int(float(r["dg_open_faces"])) for r in p]
+    force = [float(r["dg_reaction_y"]) for r in p]
+    first = opened.index(next(n for n in opened if n > 0))
+    assert float(p[first - 1]["max_plastic_strain"]) > 0, p[first - 1]      # yields before it opens
+    assert opened[-1] > opened[first] and force[first] < 0.9 * force[first - 1], (opened, force)
+    assert abs(force[-1]) < 1e-6 * max(force), force                           # separated

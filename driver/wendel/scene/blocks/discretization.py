@@ -71,8 +71,8 @@ def penalty_warnings(block: Discretization, dimension: int) -> list[str]:
 
 
 def check(block: Discretization, scene) -> None:
-    """DG joins plasticity (P1 and P2; separation with plasticity P1 only); plane 2D or 3D (3D: no separation, no
-    region); direct solver, no remesh, no prescribed motion."""
+    """DG joins plasticity (P1 and P2); plane 2D or 3D (3D: no separation, no region); direct solver, no remesh,
+    no prescribed motion."""
     if block.kind != "dg":
         if block.separation_stress > 0:
             raise ValueError("discretization.separation_stress needs discretization.kind = 'dg'")
@@ -90,9 +90,6 @@ def check(block: Discretization, scene) -> None:
     if others:
         raise ValueError(f"discretization.kind = 'dg' is implemented for elastic and plastic scenes only; "
                          f"remove [{others[0]}]")
-    if getattr(scene, "plasticity", None) is not None and block.order != 1 and block.separation_stress > 0:
-        raise ValueError("discretization.separation_stress with [plasticity] needs discretization.order = 1 (the "
-                         "P2 face stress is a matrix term, dg-plastic-p2.idp)")
     g = scene.geometry
     if (g.builder == "box" or g.dimension == 3) and (block.separation_stress > 0 or block.region is not None):
         raise ValueError("discretization.kind = 'dg' in 3D has no separation_stress and no region: FreeFEM 4.9 "
