@@ -115,8 +115,6 @@ def test_dg_3d_plasticity_matches_cg_on_a_uniform_state_and_converges_like_it_in
 
 
 @pytest.mark.parametrize("changes, message", [
-    ([("order = 1                # P1dc", "order = 2"), ("[numerics]", PLASTIC + "\n[numerics]")],
-     "with [plasticity] needs discretization.order = 1"),
     ([("gamma_lambda = 25.0 ", "separation_stress = 1e6\ngamma_lambda = 25.0 ")], "3D has no separation_stress"),
     ([("gamma_lambda = 25.0 ", "region = [[0.0, 0.0], [1.0, 1.0]]\ngamma_lambda = 25.0 ")], "and no region"),
 ])

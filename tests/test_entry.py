@@ -26,9 +26,10 @@ GUARDS = {"plasticity": "wendelPlasticityIdp", "contact": "wendelContactIdp", "t
           "axisymmetric": "wendelAxisymmetricIdp", "axisymmetric-mechanics": "wendelAxisymmetricMechanicsIdp",
           "remeshstop": "wendelRemeshStopIdp", "kinematics": "wendelKinematicsIdp",
           "friction": "wendelFrictionIdp", "tool": "wendelToolIdp", "petsc": "wendelPetscIdp", "dg": "wendelDgIdp",
-          "dg3d": "wendelDg3dIdp", "kinematics-thermal": "wendelKinematicsThermalIdp"}
+          "dg3d": "wendelDg3dIdp", "kinematics-thermal": "wendelKinematicsThermalIdp",
+          "dg-plastic-p2": "wendelDgPlasticP2Idp"}
 MODULES = ("plasticity", "contact", "thermal", "thermal-fields", "axisymmetric", "axisymmetric-mechanics", "remeshstop",
-           "kinematics", "friction", "tool", "dg", "dg3d", "kinematics-thermal")
+           "kinematics", "friction", "tool", "dg", "dg3d", "kinematics-thermal", "dg-plastic-p2")
 
 
 def compiled(tmp_path, scene_name: str, solver: str | None = None, kinematics: str | None = None

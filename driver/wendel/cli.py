@@ -80,7 +80,7 @@ def main(argv: list[str] | None = None) -> int:
     p = sub.add_parser("bench", help="benchmarks; results into results/bench/",
                        formatter_class=argparse.RawTextHelpFormatter)     # names are not wrapped at hyphens
     p.add_argument("names", nargs="*", help="benchmarks to run (default: all of these):\n"
-                   "  axisymmetric, cylinder, dg, dg-3d, drilling, elasticity, friction, obstacle, petsc, remesh,\n"
+                   "  axisymmetric, cylinder, dg, dg-3d, dg-plastic, drilling, elasticity, friction, obstacle, petsc, remesh,\n"
                    "  step42, sweep, thermal, ul,\n"
                    "  kernels (compiled element kernels against the varf forms on the ball, 2 min),\n"
                    "  necking (Simo's necking bar on 3 meshes, with and without F-bar),\n"

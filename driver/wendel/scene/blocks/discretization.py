@@ -31,7 +31,7 @@ class Discretization(BaseModel):
     model_config = ConfigDict(extra="forbid", validate_assignment=True)
 
     kind: Literal["cg", "dg"] = Field("cg", description="cg: continuous Lagrange (elasticity.order); dg: "
-                                      "interior penalty with Nitsche boundaries (2D; 3D linear elastic)")
+                                      "interior penalty with Nitsche boundaries (2D, 3D; elastic or J2 plastic)")
     order: int = Field(1, ge=1, le=2, description="polynomial degree of the DG displacement (P1dc, P2dc) [1]")
     gamma_mu: float = Field(20.0, gt=0, le=1e6, description="penalty on the jump, times 2 mu |F|/|K| [1]; "
                             "sufficient: 6 (P1), 18 (P2) in 2D, 8 and 21.3 in 3D")
@@ -71,7 +71,7 @@ def penalty_warnings(block: Discretization, dimension: int) -> list[str]:
 
 
 def check(block: Discretization, scene) -> None:
-    """DG joins plasticity (P1) only; plane 2D or 3D (3D: no separation, no region); direct solver, no remesh,
+    """DG joins plasticity (P1 and P2); plane 2D or 3D (3D: no separation, no region); direct solver, no remesh,
     no prescribed motion."""
     if block.kind != "dg":
         if block.separation_stress > 0:
@@ -90,9 +90,6 @@ def check(block: Discretization, scene) -> None:
     if others:
         raise ValueError(f"discretization.kind = 'dg' is implemented for elastic and plastic scenes only; "
                          f"remove [{others[0]}]")
-    if getattr(scene, "plasticity", None) is not None and block.order != 1:
-        raise ValueError("discretization.kind = 'dg' with [plasticity] needs discretization.order = 1 (the face "
-                         "stress is the element's one-point stress)")
     g = scene.geometry
     if (g.builder == "box" or g.dimension == 3) and (block.separation_stress > 0 or block.region is not None):
         raise ValueError("discretization.kind = 'dg' in 3D has no separation_stress and no region: FreeFEM 4.9 "
