@@ -321,20 +321,20 @@ class Process:
         (files.tables / "trac.txt").write_text(f"{len(trac)}\n" + "".join(r + "\n" for r in trac))
         loads = files.tables / "loads.txt"
         loads.write_text(f"{len(lfs)}\n" + "".join(f"{lf!r}\n" for lf in lfs))
-        opts = self.command(inc0, seg, restart, opts)
+        scene_opts, opts = opts, self.command(inc0, seg, restart, opts)
         state.pending = list(lfs)
-        before, t0 = len(state.accepted), time.perf_counter()
         ahead, self.ahead = self.ahead, None
         taken, wall = ahead is not None and ahead.options == opts, None
         k = inc0 + len(lfs) - 1                  # the step after this launch's last: its body while FreeFEM solves
         if k < len(self.steps) and self.steps[k].depth != (self.steps[k - 1].depth if k else self.depth_prev):
             kind, kwargs = self.body(self.steps[k].depth)
             self.builder.submit(kind, files.root / f"meshes/step-{k + 1:03d}.msh", kwargs)
+        self.ahead = self.start_next(inc0 + len(lfs), seg, scene_opts)     # its start beside this solve
+        before, t0 = len(state.accepted), time.perf_counter()
         try:
             freefem.run(self.entry, opts, files.fem, ranks=work.numerics.ranks, timeout=work.numerics.timeout,
                         log=files.root / "freefem.log", started=ahead)
             wall = time.perf_counter() - t0      # FreeFEM's end: the accept below is driver output (no double count)
-            self.ahead = self.start_next(inc0 + len(lfs), seg)
         finally:
             accept(work, files, state, self.dim)
             state.launches.append({"wall": wall if wall is not None else time.perf_counter() - t0,
@@ -352,10 +352,12 @@ class Process:
             ["-loads", str(files.tables / "loads.txt"), "-inc0", str(inc0)]
         return opts + (["-restart", str(files.root / restart)] if restart else [])
 
-    def start_next(self, inc: int, seg: dict):
-        """Start the launch of increment ``inc`` (the next removal step or the cooling) while the driver
-        accepts this one, removes and transfers (:mod:`wendel.prestart`); its options as
-        :meth:`removal_step` and :meth:`cool` will ask, else None. A launch asked otherwise is not taken."""
+    def start_next(self, inc: int, seg: dict, scene_opts: list[str]):
+        """Start the launch of increment ``inc`` (the next removal step or the cooling) while FreeFEM solves
+        this one and the driver accepts it, removes and transfers (:mod:`wendel.prestart`), with the options
+        :meth:`removal_step` or :meth:`cool` will ask for if nothing but the mesh, the restart and ``-inc0``
+        change (``scene_opts``: this launch's :func:`wendel.loop.launch.options`; they are not written again
+        here, FreeFEM is about to read this launch's tables); else None. A launch asked otherwise is not taken."""
         k = inc - 1                                     # the step (or cooling) just launched: increment k
         if k < len(self.steps):                         # the next removal step
             step, now = self.steps[k], self.steps[k - 1] if k >= 1 else None
@@ -369,7 +371,9 @@ class Process:
             nxt, restart = seg, str(self.files.fem / f"inc-{k:04d}")
         else:
             return None
-        return prestart.start(self.entry, self.command(inc, nxt, restart), self.files.fem,
+        opts = list(scene_opts)
+        opts[opts.index("-mesh") + 1] = str(self.files.root / nxt["mesh"])
+        return prestart.start(self.entry, self.command(inc, nxt, restart, opts), self.files.fem,
                               ranks=self.work.numerics.ranks, log=self.files.root / "freefem.log")
 
     # ---- bookkeeping after a launch
