@@ -58,7 +58,7 @@ from ..remesh import step as remeshing
 from ..remesh.removal import conservative_transfer, removed_slice_quadrature
 from ..results import summary as report, vtu as output
 from ..results.drilling import bore_profile, plots, write_csv
-from . import drilling_state as kept, launch
+from . import drilling_state as kept, launch, overlap
 from .ahead import Builder
 from .checkpoint import RunFiles, State
 from .quasistatic import accept
@@ -330,6 +330,8 @@ class Process:
             kind, kwargs = self.body(self.steps[k].depth)
             self.builder.submit(kind, files.root / f"meshes/step-{k + 1:03d}.msh", kwargs)
         self.ahead = self.start_next(inc0 + len(lfs), seg, scene_opts)     # its start beside this solve
+        if self.scene.output.png:       # the plots' imports (0.4-0.6 s) while FreeFEM solves, not at the end
+            overlap.preload("matplotlib", "matplotlib.pyplot")
         before, t0 = len(state.accepted), time.perf_counter()
         try:
             freefem.run(self.entry, opts, files.fem, ranks=work.numerics.ranks, timeout=work.numerics.timeout,
