@@ -329,7 +329,6 @@ class Process:
         if k < len(self.steps) and self.steps[k].depth != (self.steps[k - 1].depth if k else self.depth_prev):
             kind, kwargs = self.body(self.steps[k].depth)
             self.builder.submit(kind, files.root / f"meshes/step-{k + 1:03d}.msh", kwargs)
-        self.ahead = self.start_next(inc0 + len(lfs), seg, scene_opts)     # its start beside this solve
         if self.scene.output.png:       # the plots' imports (0.4-0.6 s) while FreeFEM solves, not at the end
             overlap.preload("matplotlib", "matplotlib.pyplot")
         before, t0 = len(state.accepted), time.perf_counter()
@@ -337,6 +336,9 @@ class Process:
             freefem.run(self.entry, opts, files.fem, ranks=work.numerics.ranks, timeout=work.numerics.timeout,
                         log=files.root / "freefem.log", started=ahead)
             wall = time.perf_counter() - t0      # FreeFEM's end: the accept below is driver output (no double count)
+            # the next launch starts while the driver accepts, removes and transfers; not beside this solve:
+            # there it slowed the solve on this shared machine (drilling-3d 10.8 -> 12.0 s, one run each)
+            self.ahead = self.start_next(inc0 + len(lfs), seg, scene_opts)
         finally:
             accept(work, files, state, self.dim)
             state.launches.append({"wall": wall if wall is not None else time.perf_counter() - t0,
@@ -355,11 +357,11 @@ class Process:
         return opts + (["-restart", str(files.root / restart)] if restart else [])
 
     def start_next(self, inc: int, seg: dict, scene_opts: list[str]):
-        """Start the launch of increment ``inc`` (the next removal step or the cooling) while FreeFEM solves
-        this one and the driver accepts it, removes and transfers (:mod:`wendel.prestart`), with the options
-        :meth:`removal_step` or :meth:`cool` will ask for if nothing but the mesh, the restart and ``-inc0``
-        change (``scene_opts``: this launch's :func:`wendel.loop.launch.options`; they are not written again
-        here, FreeFEM is about to read this launch's tables); else None. A launch asked otherwise is not taken."""
+        """Start the launch of increment ``inc`` (the next removal step or the cooling) while the driver accepts
+        this one, removes and transfers (:mod:`wendel.prestart`), with the options :meth:`removal_step` or
+        :meth:`cool` will ask for if nothing but the mesh, the restart and ``-inc0`` change (``scene_opts``:
+        this launch's :func:`wendel.loop.launch.options`, not computed again: that writes tables); else None.
+        A launch asked otherwise is not taken."""
         k = inc - 1                                     # the step (or cooling) just launched: increment k
         if k < len(self.steps):                         # the next removal step
             step, now = self.steps[k], self.steps[k - 1] if k >= 1 else None
