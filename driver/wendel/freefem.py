@@ -133,27 +133,19 @@ def explain_log(text: str, script: Path) -> tuple[str, str | None, int | None]:
     return f"FreeFEM stopped without a located error; log tail:\n{tail}", None, None
 
 
-def run(entry: str, options: list[str], out_dir: Path, ranks: int = 1, timeout: float = 3600.0,
-        log: Path | None = None) -> Launch:
-    """Run ``edp/<entry>`` with ``options`` on ``ranks`` MPI ranks; output files go to ``out_dir``.
-
-    Raises :class:`FreeFemError` (with .file and .line), :class:`FreeFemTimeout` or
-    :class:`NewtonFailure`.
-    """
+def _command(entry: str, options: list[str], out_dir: Path, ranks: int, gate: bool = False):
+    """The script, command line and environment of a launch."""
     script = Path(entry) if Path(entry).is_absolute() else EDP / entry
     if not script.is_file():
         raise FreeFemError(f"no entry script {script}")
     out_dir.mkdir(parents=True, exist_ok=True)
-    log = log or out_dir / "freefem.log"
-    for stale in ("error.txt", "failed.json"):
-        (out_dir / stale).unlink(missing_ok=True)
     # setpriv: mpirun gets SIGTERM (and stops its ranks) when the driver dies, even by kill -9
     # one rank: FreeFem++-mpi started alone (an MPI singleton), 0.2 s here against 0.5 s through mpirun
     # (not inside a SLURM job: there Open MPI's singleton looks for SLURM's PMI, which Debian's lacks, and aborts)
     singleton = ranks == 1 and not any(k.startswith("SLURM_JOB") for k in os.environ)
     mpi = [] if singleton else ["mpirun", "-np", str(ranks)]
     cmd = ["setpriv", "--pdeathsig", "TERM", *mpi, "FreeFem++-mpi", "-nw", "-v", "0",
-           str(script), "-out", str(out_dir), *options]
+           str(script), *(["-DWITHGATE=1"] if gate else []), "-out", str(out_dir), *options]
     env = environment()
     # Open MPI's session folder of this launch alone: concurrent runs (a sweep) sharing one raced
     # ("orte_session_dir failed") when the first to finish removed it
@@ -161,23 +153,58 @@ def run(entry: str, options: list[str], out_dir: Path, ranks: int = 1, timeout: 
     env.setdefault("OMPI_MCA_orte_tmpdir_base", session)
     if singleton:       # no orted beside the singleton: 0.1 s less per launch here (issue 20)
         env.setdefault("OMPI_MCA_ess_singleton_isolated", "1")
-    t0 = time.perf_counter()
+    return script, cmd, env, session, singleton
+
+
+def _popen(cmd, env, out_dir: Path, log: Path, stdin) -> subprocess.Popen:
     with open(log, "a") as flog:
         flog.write("$ " + " ".join(cmd) + "\n")
         flog.flush()
-        proc = subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=flog, stderr=subprocess.STDOUT, env=env,
+        return subprocess.Popen(cmd, stdin=stdin, stdout=flog, stderr=subprocess.STDOUT, env=env,
                                 start_new_session=True, cwd=out_dir)
+
+
+def run(entry: str, options: list[str], out_dir: Path, ranks: int = 1, timeout: float = 3600.0,
+        log: Path | None = None, started=None) -> Launch:
+    """Run ``edp/<entry>`` with ``options`` on ``ranks`` MPI ranks; output files go to ``out_dir``.
+    ``started``: a launch :func:`wendel.prestart.start` made ahead; taken when its entry, options, folder,
+    log and rank count are these and it still waits (else stopped, and this launch started as usual).
+
+    Raises :class:`FreeFemError` (with .file and .line), :class:`FreeFemTimeout` or
+    :class:`NewtonFailure`.
+    """
+    log = log or out_dir / "freefem.log"
+    for stale in ("error.txt", "failed.json"):
+        (out_dir / stale).unlink(missing_ok=True)
+    if started is not None and not ((started.entry, started.options, started.out_dir, started.log, ranks)
+                                    == (entry, list(options), out_dir, log, 1) and started.proc.poll() is None):
+        _kill(started.proc)         # not this launch: stopped unused (wendel.prestart.abandon)
+        started.proc.stdin.close()
+        shutil.rmtree(started.session, ignore_errors=True)
+        started = None
+    t0 = time.perf_counter()
+    if started is not None:
+        script = Path(entry) if Path(entry).is_absolute() else EDP / entry
+        proc, cmd, session = started.proc, started.cmd, started.session
         try:
-            rc = _wait(proc, timeout)
-        except subprocess.TimeoutExpired:
-            _kill(proc)
-            raise FreeFemTimeout(f"{entry}: stopped after the time limit of {timeout:g} s (numerics.timeout)",
-                                 str(script), None, log) from None
-        except BaseException:
-            _kill(proc)
-            raise
-        finally:
-            shutil.rmtree(session, ignore_errors=True)
+            proc.stdin.write(b"go\n")
+            proc.stdin.close()
+        except OSError:          # it ended (seen as its exit code below)
+            pass
+    else:
+        script, cmd, env, session, _ = _command(entry, options, out_dir, ranks)
+        proc = _popen(cmd, env, out_dir, log, subprocess.DEVNULL)
+    try:
+        rc = _wait(proc, timeout)
+    except subprocess.TimeoutExpired:
+        _kill(proc)
+        raise FreeFemTimeout(f"{entry}: stopped after the time limit of {timeout:g} s (numerics.timeout)",
+                             str(script), None, log) from None
+    except BaseException:
+        _kill(proc)
+        raise
+    finally:
+        shutil.rmtree(session, ignore_errors=True)
     wall = time.perf_counter() - t0
     if rc == 0:
         return Launch(wall, cmd)

@@ -50,7 +50,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import freefem
+from .. import freefem, prestart
 from ..meshes import LABELS
 from ..meshes import drilling as geometry
 from ..remesh import mesher, quality, transfer
@@ -58,7 +58,8 @@ from ..remesh import step as remeshing
 from ..remesh.removal import conservative_transfer, removed_slice_quadrature
 from ..results import summary as report, vtu as output
 from ..results.drilling import bore_profile, plots, write_csv
-from . import drilling_state as kept, launch
+from . import drilling_state as kept, launch, overlap
+from .ahead import Builder
 from .checkpoint import RunFiles, State
 from .quasistatic import accept
 from .steps import StepCutError
@@ -121,20 +122,24 @@ def run(scene, scene_path: Path, out: Path, smoke: bool = False, progress=print,
     state = State(pending=[])
     state.segments = []
     proc = Process(scene, work, files, state, entry, total, progress, dim)
-    proc.plain = plain
+    proc.plain, proc.steps, proc.cooling = plain, steps, cooling
     done, cooled = 0, False
     if resume:
         done, cooled = kept.restore(proc)
         progress(f"  resuming after removal step {done} of {len(steps)}{' and the cooling' if cooled else ''}")
     else:
         launch.write_tables(work, files, dim)
-    for k, step in enumerate(steps, 1):
-        if k > done:
-            proc.removal_step(k, step)
-            kept.save(proc, k, False)
-    if cooling and not cooled:
-        proc.cool(cooling)
-        kept.save(proc, len(steps), True)
+    try:
+        for k, step in enumerate(steps, 1):
+            if k > done:
+                proc.removal_step(k, step)
+                kept.save(proc, k, False)
+        if cooling and not cooled:
+            proc.cool(cooling)
+            kept.save(proc, len(steps), True)
+    finally:
+        prestart.abandon(proc.ahead)        # a launch started for a step that did not come
+        proc.builder.close()
     summary = report.write_summary(files.root, work, state, dim)
     proc.finish(summary)
     return files.root
@@ -160,20 +165,26 @@ class Process:
         self.heat_te_prev = 0.0
         self.heat_pl_prev = 0.0
         self.depth_prev = self.block.start_depth
+        self.steps, self.cooling = [], []
+        self.ahead = None                    # the next launch, started while the driver prepares it (prestart)
+        self.builder = Builder()             # the next removal step's mesh, built while FreeFEM solves
 
     # ---- the geometry of the workpiece
-    def build(self, depth: float, path: Path) -> dict:
+    def body(self, depth: float) -> tuple[str, dict]:
+        """The builder (``section``, ``cylinder`` or ``block``) and its arguments for the tip at ``depth``."""
         params = {k: v for k, v in self.g.params.items() if k != "h"}
-        workpiece = "cylinder" if self.g.builder == "drilled-cylinder" else "block"
-        with remeshing._quiet_stdout():
-            if self.axi:
-                geometry.drilled_section(path, depth=depth, diameter=self.block.diameter,
-                                         point_angle=self.block.point_angle, h=self.g.h, h_bore=self.h_bore,
-                                         grade=self.block.grade, **params)
-            else:
-                geometry.drilled(path, workpiece, depth=depth, diameter=self.block.diameter,
-                                 point_angle=self.block.point_angle, h=self.g.h, h_bore=self.h_bore,
-                                 grade=self.block.grade, **params)
+        kind = "section" if self.axi else "cylinder" if self.g.builder == "drilled-cylinder" else "block"
+        return kind, dict(depth=depth, diameter=self.block.diameter, point_angle=self.block.point_angle,
+                          h=self.g.h, h_bore=self.h_bore, grade=self.block.grade, **params)
+
+    def build(self, depth: float, path: Path) -> dict:
+        if not self.builder.take(path):          # not built ahead (wendel.loop.ahead): here
+            kind, kwargs = self.body(depth)
+            with remeshing._quiet_stdout():
+                if kind == "section":
+                    geometry.drilled_section(path, **kwargs)
+                else:
+                    geometry.drilled(path, kind, **kwargs)
         pts, _, cells, _, facets, tags = mesher.read_mesh(path)
         return {"points": pts, "cells": cells, "facets": facets, "tags": tags}
 
@@ -310,21 +321,64 @@ class Process:
         (files.tables / "trac.txt").write_text(f"{len(trac)}\n" + "".join(r + "\n" for r in trac))
         loads = files.tables / "loads.txt"
         loads.write_text(f"{len(lfs)}\n" + "".join(f"{lf!r}\n" for lf in lfs))
-        opts = launch.macros(self.plain, self.dim) + ["-DWITHSTRESSFIELDS=1"] + opts + ["-loads", str(loads), "-inc0", str(inc0)]
-        if restart:
-            opts += ["-restart", str(files.root / restart)]
+        scene_opts, opts = opts, self.command(inc0, seg, restart, opts)
         state.pending = list(lfs)
+        ahead, self.ahead = self.ahead, None
+        taken, wall = ahead is not None and ahead.options == opts, None
+        k = inc0 + len(lfs) - 1                  # the step after this launch's last: its body while FreeFEM solves
+        if k < len(self.steps) and self.steps[k].depth != (self.steps[k - 1].depth if k else self.depth_prev):
+            kind, kwargs = self.body(self.steps[k].depth)
+            self.builder.submit(kind, files.root / f"meshes/step-{k + 1:03d}.msh", kwargs)
+        if self.scene.output.png:       # the plots' imports (0.4-0.6 s) while FreeFEM solves, not at the end
+            overlap.preload("matplotlib", "matplotlib.pyplot")
         before, t0 = len(state.accepted), time.perf_counter()
         try:
             freefem.run(self.entry, opts, files.fem, ranks=work.numerics.ranks, timeout=work.numerics.timeout,
-                        log=files.root / "freefem.log")
+                        log=files.root / "freefem.log", started=ahead)
+            wall = time.perf_counter() - t0      # FreeFEM's end: the accept below is driver output (no double count)
+            # the next launch starts while the driver accepts, removes and transfers; not beside this solve:
+            # there it slowed the solve on this shared machine (drilling-3d 10.8 -> 12.0 s, one run each)
+            self.ahead = self.start_next(inc0 + len(lfs), seg, scene_opts)
         finally:
             accept(work, files, state, self.dim)
-            state.launches.append({"wall": time.perf_counter() - t0, "increments": len(state.accepted) - before,
-                                   "complete": not state.pending})
+            state.launches.append({"wall": wall if wall is not None else time.perf_counter() - t0,
+                                   "increments": len(state.accepted) - before, "complete": not state.pending,
+                                   "prestarted": taken})
         if state.pending:
             raise StepCutError(f"increment {state.last[0] + 1} of the drilling run was not accepted; "
                                       f"see {files.root / 'freefem.log'}")
+
+    def command(self, inc0: int, seg: dict, restart, opts: list[str] | None = None) -> list[str]:
+        """The FreeFEM options of a launch (``opts``: :func:`wendel.loop.launch.options` of ``seg``)."""
+        files = self.files
+        opts = launch.options(self.work, files, self.dim, seg) if opts is None else opts
+        opts = launch.macros(self.plain, self.dim) + ["-DWITHSTRESSFIELDS=1"] + opts + \
+            ["-loads", str(files.tables / "loads.txt"), "-inc0", str(inc0)]
+        return opts + (["-restart", str(files.root / restart)] if restart else [])
+
+    def start_next(self, inc: int, seg: dict, scene_opts: list[str]):
+        """Start the launch of increment ``inc`` (the next removal step or the cooling) while the driver accepts
+        this one, removes and transfers (:mod:`wendel.prestart`), with the options :meth:`removal_step` or
+        :meth:`cool` will ask for if nothing but the mesh, the restart and ``-inc0`` change (``scene_opts``:
+        this launch's :func:`wendel.loop.launch.options`, not computed again: that writes tables); else None.
+        A launch asked otherwise is not taken."""
+        k = inc - 1                                     # the step (or cooling) just launched: increment k
+        if k < len(self.steps):                         # the next removal step
+            step, now = self.steps[k], self.steps[k - 1] if k >= 1 else None
+            if now is not None and step.depth == now.depth:      # a dwell: same body, from the increment
+                nxt, restart = seg, str(self.files.fem / f"inc-{k:04d}")
+            else:
+                nxt = {"first": inc, "mesh": f"meshes/step-{inc:03d}.msh", "ubase": None, "eps0": None,
+                       "state": f"remesh/state-{inc:03d}"}
+                restart = nxt["state"]
+        elif k == len(self.steps) and self.cooling:     # the cooling on the last mesh
+            nxt, restart = seg, str(self.files.fem / f"inc-{k:04d}")
+        else:
+            return None
+        opts = list(scene_opts)
+        opts[opts.index("-mesh") + 1] = str(self.files.root / nxt["mesh"])
+        return prestart.start(self.entry, self.command(inc, nxt, restart, opts), self.files.fem,
+                              ranks=self.work.numerics.ranks, log=self.files.root / "freefem.log")
 
     # ---- bookkeeping after a launch
     def close_rows(self, rows: list[dict]) -> None:
@@ -431,7 +485,8 @@ class Process:
                        "balance_mismatch": mismatch, "balance_error": abs(mismatch) / scale},
             "remesh": {"nodes_extrapolated": [r.get("nodes_outside_old_mesh", 0) for r in rows if r["kind"] != "cool"],
                        "new_nodes": [r.get("new_nodes", r["mesh_nodes"]) for r in rows if r["kind"] != "cool"],
-                       "remesh_transfer_share": shares,
+                       "remesh_transfer_share": shares, "meshes_built_ahead": self.builder.taken,
+                       "launches_started_ahead": sum(bool(l.get("prestarted")) for l in self.state.launches),
                        "mean_remesh_transfer_share": float(np.mean(shares)) if shares else 0.0,
                        "step_seconds": [r.get("remesh_seconds", 0) + r.get("transfer_seconds", 0)
                                         + r.get("chips_seconds", 0) + r.get("launch_seconds", 0)

@@ -35,6 +35,7 @@ import numpy as np
 
 from ..meshes import LABELS
 from ..meshes.builders import start_gmsh
+from ..results import meshfile
 from . import bodies, quality
 
 OPENED = LABELS["opened"]      # the faces a DG separation opened (separated.msh)
@@ -51,7 +52,7 @@ def read_mesh(path):
     ``cells`` are the triangles (2D) or tetrahedra (3D) in file order, ``facets`` the labelled boundary
     lines/triangles, tags are the gmsh physical tags (0 when a block has none).
     """
-    m = meshio.read(path)
+    m = meshfile.read(path)        # parsed once while the file stays unchanged (shared: copies below)
     dim = 3 if any(c.type == "tetra" for c in m.cells) else 2
     phys = m.cell_data.get("gmsh:physical")
 
@@ -65,7 +66,7 @@ def read_mesh(path):
 
     cells, cell_tags = gather(_VOLUME[dim])
     facets, facet_tags = gather(_FACET[dim])
-    return m.points, dim, cells, cell_tags, facets, facet_tags
+    return m.points.copy(), dim, cells, cell_tags, facets, facet_tags
 
 
 def boundary_facets(cells):

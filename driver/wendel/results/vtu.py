@@ -89,10 +89,10 @@ def write_array(path: Path, values) -> None:
 
 def read_mesh(path: Path, dimension: int) -> tuple[np.ndarray, np.ndarray]:
     """Points (n, 3) and the cells of the given dimension of a gmsh file."""
-    import meshio       # here: its import (0.2 s) is off a run's critical path (wendel.loop.overlap.preload)
-    m = meshio.read(path, file_format="gmsh")
+    from . import meshfile      # meshio is imported there, off a run's critical path (wendel.loop.overlap.preload)
+    m = meshfile.read(path, "gmsh")         # parsed once while the file stays unchanged: copies below
     cells = np.concatenate([b.data for b in m.cells if b.type == CELL_TYPES[dimension]])
-    return m.points, cells
+    return m.points.copy(), cells
 
 
 def read_vertices(vertices_txt: Path) -> np.ndarray:
