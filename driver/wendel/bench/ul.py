@@ -20,11 +20,14 @@ def ul_bench(quick: bool, workdir: Path) -> list[dict]:
     # small strain is nonlinear too (the plastic zone spreads from the imperfection)
     cases += [("axi", "ul-necking-bar.toml", h) for h in ([1e-3] if quick else [1e-3, 0.5e-3])]
     rows = []
-    for dim, name, h in cases:
+    # each case with the accepted state as the first guess of an increment, and with the extrapolated one
+    # (numerics.predictor, edp/lib/predictor.idp): small strain and updated-Lagrangian alike
+    for (dim, name, h), predictor in ((c, p) for c in cases for p in ("none", "extrapolate")):
         path = WORKFLOWS / name
-        row = {"case": dim, "h": h}
+        row = {"case": dim, "h": h, "predictor": predictor}
         for kind in ("small-strain", "updated-lagrangian"):
             scene = load(path)
+            scene.numerics.predictor = predictor
             scene.geometry.h = h
             scene.kinematics.kind = kind
             scene.loading.steps = 5
@@ -38,7 +41,7 @@ def ul_bench(quick: bool, workdir: Path) -> list[dict]:
                 scene.geometry.params["refine"]["h"] = 0.4 * h
             scene.output.png = False
             scene.output.vtu = False
-            out = workdir / f"{dim}-h{h:g}-{kind}"
+            out = workdir / f"{dim}-h{h:g}-{kind}-{predictor}"
             s = run_fresh(scene, path, out)
             ph = s["wall_time_by_phase"]
             work = ph["assembly"] + ph["linear_solve"] + ph["constitutive"]

@@ -70,6 +70,8 @@ def options(scene: Scene, files: RunFiles, dimension: int, segment: dict | None 
             "-newton_tol", repr(n.newton_tol), "-newton_maxit", str(n.newton_maxit)]
     if n.forcing != "fixed":
         opts += ["-solver_forcing", n.forcing]
+    if n.predictor == "extrapolate":
+        opts += ["-newton_predictor", "1"]     # edp/lib/predictor.idp
     if n.solver == "petsc":
         opts += petsc.launch_options(n.petsc.pc, n.petsc.options, n.petsc.reuse)
     if scene.problem != "mechanics":

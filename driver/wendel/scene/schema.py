@@ -197,6 +197,11 @@ class Numerics(Strict):
                                             "Eisenstat-Walker's forcing term (0.1 at most, no tighter than the "
                                             "Newton tolerance needs); the Newton tolerance is unchanged")
     newton_maxit: int = Field(25, ge=1, le=500, description="Newton iterations per increment")
+    predictor: Literal["none", "extrapolate"] = Field("none", description="first guess of an increment: none = "
+                                                      "the accepted state; extrapolate = plus the last increment's "
+                                                      "displacement increment scaled to the load step (one Newton "
+                                                      "iteration less on a smooth nonlinear path; "
+                                                      "edp/lib/predictor.idp)")
     timeout: float = Field(3600.0, gt=0, description="wall-time limit of one FreeFEM launch [s]")
     petsc: Petsc = Field(default_factory=Petsc, description="PETSc solver settings (solver = \"petsc\")")
     assembly: AssemblyName = Field("freefem", description="tangent, internal forces and strains: freefem (the varf "

@@ -1,0 +1,82 @@
+"""The Newton method of the updated-Lagrangian kinematics: its tangent against finite differences of its residual
+(edp/lib/fdcheck.idp, -newton_fd_check), and the extrapolated first guess of an increment (numerics.predictor,
+edp/lib/predictor.idp) on the 3D tension cube of `wendel bench ul`."""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import pytest
+
+from wendel import freefem
+from wendel.loop import run
+from wendel.results import vtu as output
+
+from conftest import WORKFLOWS
+
+
+def tension_cube(scene_file, name: str, strain: float, steps: int, extra: str = "") -> Path:
+    """ul-tension-3d.toml on a mesh of h = 0.5 m, pulled to ``strain`` in ``steps`` increments."""
+    text = (WORKFLOWS / "ul-tension-3d.toml").read_text()
+    for old, new in (("uz = 1.0 ", f"uz = {strain!r} "), ("steps = 20", f"steps = {steps}"),
+                     ("[output]", f"{extra}\n[output]")):      # extra: keys of [numerics], the table before
+        assert old in text
+        text = text.replace(old, new, 1)
+    return scene_file(text, f"{name}.toml")
+
+
+def rows(path: Path) -> list[dict]:
+    with open(path) as f:
+        return list(csv.DictReader(f))
+
+
+def relaunch(root: Path, out: Path, *extra: str) -> Path:
+    """The run's FreeFEM launch again with more options, into ``out``."""
+    words = (root / "freefem.log").read_text().splitlines()[0].split()
+    opts = words[words.index("-out") + 2:]
+    freefem.run("mechanics.edp", opts + list(extra), out)
+    return out
+
+
+@pytest.mark.parametrize("volumetric", ["cell", "fbar"])
+def test_3d_tangent_matches_the_residual_differences_at_a_deformed_plastic_state(scene_file, tmp_path, quiet,
+                                                                                 volumetric):
+    # 3 increments of 1 % (plastic from the first): the tangent along each Newton direction is the residual's
+    # derivative to the difference quotient's accuracy (measured 2e-10 to 4e-9), so Newton is quadratic; in a
+    # random direction the derivative of ln V taken as sym grad shows, of the order of the increment's strain
+    # times the plastic tangent (measured 1e-5 to 1.5e-5 at 1 %, 1.5e-4 to 2.4e-4 at 10 %); at the start of the
+    # first increment (f = I, elastic) it is exact. F-bar: its patch term through the augmented solve
+    # (kinematics-fbar.idp; a homogeneous state, but the random direction is not)
+    scene = tension_cube(scene_file, "fd", 0.03, 3)
+    scene.write_text(scene.read_text().replace('kind = "updated-lagrangian"',
+                                               f'kind = "updated-lagrangian"\nvolumetric = "{volumetric}"'))
+    root = run(scene, out=tmp_path / "run", progress=quiet, png=False)
+    out = relaunch(root, tmp_path / "fd", "-newton_fd_check", "1e-6")
+    fd = rows(out / "fdcheck.csv")
+    newton = [float(r["relative_difference"]) for r in fd if r["direction"] == "newton"]
+    random = [float(r["relative_difference"]) for r in fd if r["direction"] == "random" and r["iteration"] != "0"]
+    start = [float(r["relative_difference"]) for r in fd if (r["increment"], r["iteration"]) == ("1", "0")]
+    assert len(newton) >= 6 and max(newton) < 1e-7
+    assert len(random) == len(newton) and 1e-7 < max(random) < 1e-3
+    assert len(start) == 1 and start[0] < 1e-8
+    # the check leaves the Newton path alone
+    for inc in ("inc-0001", "inc-0002", "inc-0003"):
+        plain = [r["residual"] for r in rows(root / "fem" / inc / "newton.csv")]
+        assert [r["residual"] for r in rows(out / inc / "newton.csv")] == plain
+
+
+def test_extrapolated_predictor_saves_a_newton_iteration_per_increment(scene_file, tmp_path, quiet):
+    # 5 increments of 1 %: from the accepted state each plastic increment takes 3 Newton iterations (relative
+    # residuals 0.016, 3e-7, 1e-14: quadratic, the first step's error is the path's curvature); from the
+    # extrapolated guess (residual 0.03) 2 (1e-6, 1e-14), once the previous increment was a plastic one
+    its, stress = {}, {}
+    for predictor in ("none", "extrapolate"):
+        scene = tension_cube(scene_file, predictor, 0.05, 5, f'predictor = "{predictor}"')
+        root = run(scene, out=tmp_path / predictor, progress=quiet, png=False)
+        its[predictor] = [len(rows(d / "newton.csv")) - 1 for d in sorted((root / "fem").glob("inc-*"))]
+        stress[predictor] = output.read_array(root / "fem" / "inc-0005" / "stress_zz.cell.txt")
+    assert its["none"][2:] == [3, 3, 3]
+    assert its["extrapolate"][2:] == [2, 2, 2]
+    assert its["extrapolate"][:2] == its["none"][:2] or sum(its["extrapolate"]) < sum(its["none"])
+    assert abs(stress["extrapolate"] - stress["none"]).max() <= 1e-10 * abs(stress["none"]).max()
