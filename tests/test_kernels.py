@@ -44,11 +44,21 @@ def test_compiled_kernels_reproduce_the_varf_assembly(tmp_path, ball_freefem):
 
 
 def test_compiled_kernels_on_two_petsc_ranks(tmp_path, ball_freefem):
-    """Every rank runs the kernels on the whole mesh; PETSc solves on both: the same iterates."""
-    (f, uf), (c, uc) = ball_freefem, ball(tmp_path / "np2", "compiled", solver="petsc", ranks=2)
-    assert c["last_increment"]["ranks"] == 2
-    assert c["newton_iterations"] == f["newton_iterations"]
-    assert c["last_increment"]["contact_force"] == pytest.approx(f["last_increment"]["contact_force"], rel=1e-7)
+    """Rank-local assembly: each of 2 PETSc ranks assembles its own slab of tetrahedra and the plugin adds the
+    parts; the iterates, force, active set and KKT residuals of 1 PETSc rank and of the varf forms."""
+    (f, uf) = ball_freefem
+    (p, up), (c, uc) = (ball(tmp_path / f"np{r}", "compiled", solver="petsc", ranks=r) for r in (1, 2))
+    lp, lc = p["last_increment"], c["last_increment"]
+    assert lc["ranks"] == 2 and lp["ranks"] == 1
+    assert 0 < lc["petsc_local_tets"] < 0.75 * lc["elements"] and lp["petsc_local_tets"] == 0
+    assert c["newton_iterations"] == p["newton_iterations"] == f["newton_iterations"]
+    assert lc["contact_active_nodes"] == lp["contact_active_nodes"] == f["last_increment"]["contact_active_nodes"]
+    assert lc["plastic_points"] == lp["plastic_points"]
+    for key in ("contact_force", "max_von_mises", "plastic_volume"):
+        assert lc[key] == pytest.approx(lp[key], rel=1e-7), key
+    assert lc["contact_force"] == pytest.approx(f["last_increment"]["contact_force"], rel=1e-7)
+    assert lc["kkt_max_complementarity"] <= 1e-8 and lc["kkt_max_penetration"] <= 1e-8
+    assert np.abs(uc - up).max() <= 1e-7 * np.abs(up).max()
     assert np.abs(uc - uf).max() <= 1e-7 * np.abs(uf).max()
 
 

@@ -16,6 +16,14 @@
 //       eps (resized to 6 nt) = Mandel strain of the P1 displacement u per tetrahedron, component-major.
 //   long wendelInternal3(mesh3 Th, real[int] sig, real[int] f);
 //       f (resized to 3 nv) = the integral of sig : eps(v) (sig Mandel per tetrahedron, component-major).
+//   long wendelPart3(mesh3 Th, long rank, long size, real[int] order);
+//       Rank-local assembly on `size` MPI ranks: the vertices sorted along the axis of the bounding box's
+//       largest extent are cut into `size` slabs of equal vertex counts; `order` (resized to 3 nv) gets the
+//       global (PETSc) index of every DoF, 3 (slab-ordered vertex) + component, so that rank r's rows are the
+//       r-th contiguous block; a tetrahedron belongs to the rank owning its lowest-ordered vertex. From then on
+//       wendelTangent3 and wendelInternal3 sum over this rank's tetrahedra only (K and f are this rank's
+//       parts: the sum over the ranks is the whole), and wendelTangent3 leaves the fixed rows to the solver
+//       (no 1 on their diagonal). size 1 undoes it. Returns the number of this rank's tetrahedra.
 //
 // The CSR pattern of K (every vertex pair of a tetrahedron, 3 x 3 blocks, sorted columns) and the position
 // of each tetrahedron's blocks in it are kept for the last mesh (its address, vertex and element counts).
@@ -36,14 +44,26 @@ struct Pattern {
     std::vector<int> off;            // per tetrahedron, 16 entries: index of vertex b in a's neighbour list
 };
 Pattern pat;
+std::vector<char> own;               // wendelPart3: 1 for this rank's tetrahedra; empty = every tetrahedron
+const Mesh3* ownMesh = nullptr;
 
 const double s2 = std::sqrt(2.0);
+
+// Is tetrahedron k assembled on this rank (wendelPart3)?
+bool mine(long k) { return own.empty() || own[k]; }
+
+void checkPart(const Mesh3& Th)
+{
+    if (!own.empty() && (ownMesh != &Th || (long)own.size() != Th.nt))
+        ExecError("wendel_kernels: the mesh changed after wendelPart3; partition the new mesh");
+}
 
 void buildPattern(const Mesh3& Th)
 {
     const long nv = Th.nv, nt = Th.nt;
     std::vector<std::vector<int>> nb(nv);
     for (long k = 0; k < nt; ++k) {
+        if (!mine(k)) continue;
         const Tet& K = Th[k];
         int v[4];
         for (int i = 0; i < 4; ++i) v[i] = Th(K[i]);
@@ -70,6 +90,7 @@ void buildPattern(const Mesh3& Th)
         }
     pat.off.resize(16 * (size_t)nt);
     for (long k = 0; k < nt; ++k) {
+        if (!mine(k)) continue;
         const Tet& K = Th[k];
         int v[4];
         for (int i = 0; i < 4; ++i) v[i] = Th(K[i]);
@@ -123,10 +144,12 @@ long wendelTangent3(Matrice_Creuse<double>* const& K, const Mesh3* const& pTh, K
     if (th2mu->N() != nt || g2mu->N() != nt || nrm->N() != 6 * nt)
         ExecError("wendelTangent3: th2mu and g2mu need one value per tetrahedron, nrm six");
     if (fix->N() != n) ExecError("wendelTangent3: fix needs one value per DoF (3 per vertex)");
+    checkPart(Th);
     ensurePattern(Th);
     std::vector<double> val(pat.col.size(), 0.0);
     double g[4][3], w[4][3], N[3][3];
     for (long k = 0; k < nt; ++k) {
+        if (!mine(k)) continue;
         const Tet& T = Th[k];
         gradients(T, g);
         const double vol = T.mesure(), th = (*th2mu)[k], gm = (*g2mu)[k];
@@ -149,7 +172,7 @@ long wendelTangent3(Matrice_Creuse<double>* const& K, const Mesh3* const& pTh, K
             }
         }
     }
-    for (long r = 0; r < n; ++r)
+    for (long r = 0; r < n && own.empty(); ++r)      // parts: the solver sets the fixed rows of the sum
         if ((*fix)[r] > 0.5)
             for (int q = pat.rowptr[r]; q < pat.rowptr[r + 1]; ++q) val[q] = pat.col[q] == r ? 1.0 : 0.0;
     K->resize(n, n);
@@ -192,10 +215,12 @@ long wendelInternal3(const Mesh3* const& pTh, KN<double>* const& sig, KN<double>
     const Mesh3& Th = *pTh;
     const long nt = Th.nt, n = 3 * Th.nv;
     if (sig->N() != 6 * nt) ExecError("wendelInternal3: sig needs 6 values per tetrahedron");
+    checkPart(Th);
     f->resize(n);
     *f = 0.0;
     double g[4][3], S[3][3];
     for (long k = 0; k < nt; ++k) {
+        if (!mine(k)) continue;
         const Tet& T = Th[k];
         gradients(T, g);
         tensor(*sig, nt, k, S);
@@ -209,6 +234,48 @@ long wendelInternal3(const Mesh3* const& pTh, KN<double>* const& sig, KN<double>
     return n;
 }
 
+long wendelPart3(const Mesh3* const& pTh, const long& rank, const long& size, KN<double>* const& order)
+{
+    const Mesh3& Th = *pTh;
+    const long nv = Th.nv, nt = Th.nt;
+    if (size < 1 || rank < 0 || rank >= size) ExecError("wendelPart3: rank must be in [0, size)");
+    pat = Pattern();                                  // the pattern follows the part
+    order->resize(3 * nv);
+    if (size == 1) {
+        own.clear();
+        ownMesh = nullptr;
+        for (long i = 0; i < 3 * nv; ++i) (*order)[i] = i;
+        return nt;
+    }
+    R3 lo = Th.vertices[0], hi = lo;
+    for (long a = 0; a < nv; ++a) {
+        const R3& P = Th.vertices[a];
+        lo.x = std::min(lo.x, P.x); lo.y = std::min(lo.y, P.y); lo.z = std::min(lo.z, P.z);
+        hi.x = std::max(hi.x, P.x); hi.y = std::max(hi.y, P.y); hi.z = std::max(hi.z, P.z);
+    }
+    const R3 ext = hi - lo;
+    const int axis = (ext.x >= ext.y && ext.x >= ext.z) ? 0 : (ext.y >= ext.z ? 1 : 2);
+    std::vector<long> byPos(nv);
+    for (long a = 0; a < nv; ++a) byPos[a] = a;
+    auto coord = [&Th, axis](long a) { const R3& P = Th.vertices[a]; return axis == 0 ? P.x : axis == 1 ? P.y : P.z; };
+    std::stable_sort(byPos.begin(), byPos.end(), [&coord](long a, long b) { return coord(a) < coord(b); });
+    std::vector<long> pos(nv);
+    for (long p = 0; p < nv; ++p) pos[byPos[p]] = p;
+    for (long a = 0; a < nv; ++a)
+        for (int d = 0; d < 3; ++d) (*order)[3 * a + d] = 3 * pos[a] + d;
+    const long start = nv * rank / size, end = nv * (rank + 1) / size;   // the petsc plugin's row blocks
+    own.assign(nt, 0);
+    long mineCount = 0;
+    for (long k = 0; k < nt; ++k) {
+        const Tet& T = Th[k];
+        long p = pos[Th(T[0])];
+        for (int i = 1; i < 4; ++i) p = std::min(p, pos[Th(T[i])]);
+        if (p >= start && p < end) { own[k] = 1; ++mineCount; }
+    }
+    ownMesh = &Th;
+    return mineCount;
+}
+
 }  // namespace
 
 static void Load_Init()
@@ -219,5 +286,6 @@ static void Load_Init()
     Global.Add("wendelStrain3", "(", new OneOperator3_<long, const Mesh3*, KN<double>*, KN<double>*>(wendelStrain3));
     Global.Add("wendelInternal3", "(",
                new OneOperator3_<long, const Mesh3*, KN<double>*, KN<double>*>(wendelInternal3));
+    Global.Add("wendelPart3", "(", new OneOperator4_<long, const Mesh3*, long, long, KN<double>*>(wendelPart3));
 }
 LOADFUNC(Load_Init)

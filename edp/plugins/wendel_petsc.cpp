@@ -36,6 +36,14 @@
 // On N MPI ranks (FreeFem++-mpi) every rank passes the same whole system; each rank builds its block of
 // rows (whole nodes) of an MPIAIJ matrix, the solve runs on all ranks, and every rank gets the whole x.
 //
+//   wendelPetscLayout(real[int] order): rank-local assembly (the compiled kernels' wendelPart3 gives
+//   `order`, the global PETSc index of every DoF, rank r's rows a contiguous block). From then on, on 2+ ranks,
+//   a displacement system of that size is taken as this rank's part: K holds the sum over this rank's
+//   elements only (the whole matrix is the sum of the ranks' parts; fixed rows need not be set), b the whole
+//   right-hand side (the same on every rank) and fix is required. Each rank adds its entries into the
+//   MPIAIJ matrix (ADD_VALUES: PETSc moves the entries of rows owned by another rank), the fixed rows and
+//   columns become identity rows scaled by the mean free diagonal of the sum, as on one rank. Size 0 undoes it.
+//
 // State kept between calls: one cached solver (Mat, KSP, CSR pattern and the permutation from K's triplets
 // to it) under the key (n, nnz, bs, checksum of the triplet indices, options string). A call with another
 // key rebuilds everything; a call with the same key refills the values and reuses the KSP.
@@ -69,6 +77,9 @@ struct Cache {
     std::vector<PetscScalar> val;              // values in CSR order
     PetscInt rstart = 0, rend = 0;             // this rank's rows (whole nodes: multiples of bs)
     PetscMPIInt size = 1;
+    bool parts = false;                        // wendelPetscLayout: K is this rank's part of the sum
+    std::vector<PetscInt> gcol;                // parts: global (PETSc) column of every CSR entry
+    std::vector<long> owned;                   // parts: the DoFs whose (PETSc) rows are this rank's
     bool reuse = true;
     double rateAtSetup = 0;                    // digits of residual reduction per iteration after the setup
     double setupIts = 20;                      // -wendel_pc_setup_its: a setup's cost in Krylov iterations
@@ -78,6 +89,8 @@ struct Cache {
 Cache cache;
 bool petscUp = false;
 double forcedRtol = 0;                         // wendelPetscRtol: > 0 overrides -ksp_rtol
+std::vector<PetscInt> layout;                  // wendelPetscLayout: PETSc index of every DoF (empty: identity)
+bool layoutNew = false;                        // a new layout: rebuild the cached solver at the next solve
 
 PetscErrorCode destroyCache()
 {
@@ -168,6 +181,31 @@ PetscErrorCode fillValues(const HashMatrix<int, double>& H, const KN<double>& fi
         v[cache.perm[k]] = a;
     }
     *scale = 1.;
+    if (cache.parts) {                         // the diagonal of the sum is the sum of the parts' diagonals
+        double part[2] = {0., 0.}, sum[2];
+        for (long i = 0; i < n; ++i) {
+            if (fix[i] > 0.5) continue;
+            if (cache.diag[i] >= 0) part[0] += v[cache.diag[i]];
+            part[1] += 1.;                     // every rank counts all free rows: divided by size below
+        }
+        PetscCallMPI(MPI_Allreduce(part, sum, 2, MPI_DOUBLE, MPI_SUM, PETSC_COMM_WORLD));
+        if (sum[1] > 0 && sum[0] > 0) *scale = std::fabs(sum[0]) / (sum[1] / cache.size);
+        PetscCall(MatZeroEntries(cache.A));
+        for (long i = 0; i < n; ++i) {
+            PetscInt p = cache.rowptr[i], g = layout[i];
+            if (cache.rowptr[i + 1] > p)
+                PetscCall(MatSetValues(cache.A, 1, &g, cache.rowptr[i + 1] - p, cache.gcol.data() + p, v.data() + p,
+                                       ADD_VALUES));
+        }
+        for (long i : cache.owned)
+            if (fix[i] > 0.5) {
+                PetscInt g = layout[i];
+                PetscCall(MatSetValues(cache.A, 1, &g, 1, &g, scale, ADD_VALUES));
+            }
+        PetscCall(MatAssemblyBegin(cache.A, MAT_FINAL_ASSEMBLY));
+        PetscCall(MatAssemblyEnd(cache.A, MAT_FINAL_ASSEMBLY));
+        PetscFunctionReturn(0);
+    }
     if (masked) {
         double sum = 0;
         long nFree = 0;
@@ -217,7 +255,38 @@ PetscErrorCode setupSolver(const KN<double>& coords, long bs)
     PetscCall(MatSetType(cache.A, cache.size == 1 ? MATSEQAIJ : MATMPIAIJ));
     PetscCall(MatSetBlockSize(cache.A, (PetscInt)bs));
     std::vector<PetscScalar> zero(cache.nnz, 0.);
-    if (cache.size == 1)
+    std::vector<PetscInt> inverse;             // parts: the DoF of every PETSc index
+    if (cache.parts) {                         // the pattern of the sum: PETSc's preallocator gathers the parts'
+        inverse.assign(n, -1);
+        for (PetscInt i = 0; i < n; ++i) {
+            PetscCheck(layout[i] >= 0 && layout[i] < n && inverse[layout[i]] < 0, PETSC_COMM_SELF,
+                       PETSC_ERR_ARG_WRONG, "wendelPetscLayout: not a permutation of 0..%ld", (long)n - 1);
+            inverse[layout[i]] = i;
+        }
+        cache.gcol.resize(cache.col.size());
+        for (size_t q = 0; q < cache.col.size(); ++q) cache.gcol[q] = layout[cache.col[q]];
+        cache.owned.clear();
+        for (PetscInt g = cache.rstart; g < cache.rend; ++g) cache.owned.push_back(inverse[g]);
+        Mat P;
+        PetscCall(MatCreate(comm, &P));
+        PetscCall(MatSetType(P, MATPREALLOCATOR));
+        PetscCall(MatSetSizes(P, nloc, nloc, n, n));
+        PetscCall(MatSetBlockSize(P, (PetscInt)bs));
+        PetscCall(MatSetUp(P));
+        for (PetscInt i = 0; i < n; ++i) {
+            PetscInt p = cache.rowptr[i], g = layout[i];
+            if (cache.rowptr[i + 1] > p)
+                PetscCall(MatSetValues(P, 1, &g, cache.rowptr[i + 1] - p, cache.gcol.data() + p, zero.data() + p,
+                                       INSERT_VALUES));
+        }
+        PetscScalar z = 0;
+        for (PetscInt g = cache.rstart; g < cache.rend; ++g) PetscCall(MatSetValues(P, 1, &g, 1, &g, &z, INSERT_VALUES));
+        PetscCall(MatAssemblyBegin(P, MAT_FINAL_ASSEMBLY));
+        PetscCall(MatAssemblyEnd(P, MAT_FINAL_ASSEMBLY));
+        PetscCall(MatPreallocatorPreallocate(P, PETSC_TRUE, cache.A));
+        PetscCall(MatDestroy(&P));
+    }
+    else if (cache.size == 1)
         PetscCall(MatSeqAIJSetPreallocationCSR(cache.A, cache.rowptr.data(), cache.col.data(), zero.data()));
     else {
         std::vector<PetscInt> ia(nloc + 1);
@@ -235,7 +304,7 @@ PetscErrorCode setupSolver(const KN<double>& coords, long bs)
         PetscCall(VecSetType(c, VECSTANDARD));
         PetscScalar* pc;
         PetscCall(VecGetArray(c, &pc));
-        for (PetscInt i = 0; i < nloc; ++i) pc[i] = coords[cache.rstart + i];
+        for (PetscInt i = 0; i < nloc; ++i) pc[i] = coords[cache.parts ? inverse[cache.rstart + i] : cache.rstart + i];
         PetscCall(VecRestoreArray(c, &pc));
         PetscCall(MatNullSpaceCreateRigidBody(c, &ns));
         PetscCall(MatSetNearNullSpace(cache.A, ns));
@@ -278,9 +347,19 @@ PetscErrorCode solve(Matrice_Creuse<double>* K, KN<double>* b, KN<double>* x, KN
                (long)fix->N(), n);
     PetscCheck(bs >= 1 && n % bs == 0, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "block size %ld does not divide %ld", bs, n);
     PetscCall(startPetsc());
+    PetscMPIInt size;
+    PetscCallMPI(MPI_Comm_size(PETSC_COMM_WORLD, &size));
+    const bool parts = size > 1 && (long)layout.size() == n;
+    PetscCheck(!parts || fix->N() == n, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ,
+               "rank-local assembly (wendelPetscLayout) needs the fixed rows (fix of size %ld)", n);
     uint64_t pattern = checksum(H->i, H->j, H->nnz);
     bool same = cache.A && cache.n == n && cache.nnz == (long)H->nnz && cache.bs == bs && cache.pattern == pattern
-                && cache.options == options;
+                && cache.options == options && cache.parts == parts && !layoutNew;
+    if (size > 1) {                            // the parts' patterns differ: every rank rebuilds or none
+        int mineSame = same, allSame = 0;
+        PetscCallMPI(MPI_Allreduce(&mineSame, &allSame, 1, MPI_INT, MPI_LAND, PETSC_COMM_WORLD));
+        same = allSame;
+    }
     if (!same) {
         PetscCall(destroyCache());
         PetscCall(PetscOptionsClear(NULL));
@@ -290,6 +369,8 @@ PetscErrorCode solve(Matrice_Creuse<double>* K, KN<double>* b, KN<double>* x, KN
         cache.bs = bs;
         cache.pattern = pattern;
         cache.options = options;
+        cache.parts = parts;
+        layoutNew = false;
         PetscCall(buildPattern(*H));
         PetscCall(setupSolver(*coords, bs));
     }
@@ -297,8 +378,11 @@ PetscErrorCode solve(Matrice_Creuse<double>* K, KN<double>* b, KN<double>* x, KN
     PetscCall(fillValues(*H, *fix, &scale));
     PetscScalar* pb;
     PetscCall(VecGetArray(cache.b, &pb));
-    for (long i = cache.rstart; i < cache.rend; ++i)
-        pb[i - cache.rstart] = (fix->N() == n && (*fix)[i] > 0.5) ? scale * (*b)[i] : (*b)[i];
+    if (cache.parts)
+        for (long i : cache.owned) pb[layout[i] - cache.rstart] = (*fix)[i] > 0.5 ? scale * (*b)[i] : (*b)[i];
+    else
+        for (long i = cache.rstart; i < cache.rend; ++i)
+            pb[i - cache.rstart] = (fix->N() == n && (*fix)[i] > 0.5) ? scale * (*b)[i] : (*b)[i];
     PetscCall(VecRestoreArray(cache.b, &pb));
 
     bool reused = false;
@@ -362,7 +446,10 @@ PetscErrorCode solve(Matrice_Creuse<double>* K, KN<double>* b, KN<double>* x, KN
     }
     const PetscScalar* px;
     PetscCall(VecGetArrayRead(xs, &px));
-    for (long i = 0; i < n; ++i) (*x)[i] = px[i];
+    if (cache.parts)
+        for (long i = 0; i < n; ++i) (*x)[i] = px[layout[i]];
+    else
+        for (long i = 0; i < n; ++i) (*x)[i] = px[i];
     PetscCall(VecRestoreArrayRead(xs, &px));
     info->resize(6);
     (*info)[0] = its;
@@ -399,8 +486,17 @@ double wendelPetscRtol(const double& rtol)
     return rtol;
 }
 
+long wendelPetscLayout(KN<double>* const& order)
+{
+    layout.resize(order->N());
+    for (long i = 0; i < order->N(); ++i) layout[i] = (PetscInt)std::lround((*order)[i]);
+    layoutNew = true;
+    return order->N();
+}
+
 static void Load_Init()
 {
+    Global.Add("wendelPetscLayout", "(", new OneOperator1_<long, KN<double>*>(wendelPetscLayout));
     Global.Add("wendelPetscRtol", "(", new OneOperator1_<double, double>(wendelPetscRtol));
     Global.Add("wendelPetscSolve", "(",
                new OneOperator8_<long, Matrice_Creuse<double>*, KN<double>*, KN<double>*, KN<double>*, KN<double>*,
