@@ -26,31 +26,27 @@ def _newton(out: Path) -> int:
     return json.loads((out / "summary.json").read_text())["newton_iterations"]
 
 
-def _cylinder(quick: bool, workdir: Path) -> list[dict]:
-    sizes = {"cg1": [0.1, 0.05, 0.025], "dg1": [0.1, 0.05, 0.025], "dg2": [0.1, 0.05]}
+def _rows(part: str, scene: Path, sizes: dict[str, list[float]], quick: bool, workdir: Path, measure) -> list[dict]:
+    """One run per method and size (only the first size with --quick); ``measure(record)`` gives the part's figure."""
     rows = []
     for method, hs in sizes.items():
         for h in hs[:1] if quick else hs:
-            out = workdir / f"cylinder-{method}-h{h:g}"
-            r = _run(CYLINDER, method, h, out)
-            rows.append({"part": "cylinder", "method": method, "h": h, "dofs": r["dofs"],
-                         "error": r["record"]["error_plastic_radius"], "newton_iterations": _newton(out),
-                         "plastic_points": r["record"]["plastic_points"], "wall_time": r["wall_time"],
-                         "work_time": r["work_time"]})
+            out = workdir / f"{part}-{method}-h{h:g}"
+            r = _run(scene, method, h, out)
+            rows.append({"part": part, "method": method, "h": h, "dofs": r["dofs"], **measure(r["record"]),
+                         "newton_iterations": _newton(out), "plastic_points": r["record"]["plastic_points"],
+                         "wall_time": r["wall_time"], "work_time": r["work_time"]})
     return rows
+
+
+def _cylinder(quick: bool, workdir: Path) -> list[dict]:
+    sizes = {"cg1": [0.1, 0.05, 0.025], "dg1": [0.1, 0.05, 0.025], "dg2": [0.1, 0.05]}
+    return _rows("cylinder", CYLINDER, sizes, quick, workdir, lambda rec: {"error": rec["error_plastic_radius"]})
 
 
 def _beam(quick: bool, workdir: Path) -> list[dict]:
     sizes = {"cg1": [0.5, 0.25, 0.125, 0.0625], "dg1": [0.5, 0.25], "dg2": [1.0, 0.5]}
-    rows = []
-    for method, hs in sizes.items():
-        for h in hs[:1] if quick else hs:
-            out = workdir / f"beam-{method}-h{h:g}"
-            r = _run(BEAM, method, h, out)
-            rows.append({"part": "beam", "method": method, "h": h, "dofs": r["dofs"],
-                         "tip_deflection": -r["record"]["probe_uz"], "newton_iterations": _newton(out),
-                         "plastic_points": r["record"]["plastic_points"], "wall_time": r["wall_time"],
-                         "work_time": r["work_time"]})
+    rows = _rows("beam", BEAM, sizes, quick, workdir, lambda rec: {"tip_deflection": -rec["probe_uz"]})
     ref = next(r["tip_deflection"] for r in reversed(rows) if r["method"] == "cg1")
     for r in rows:
         r["error"] = r["tip_deflection"] / ref - 1.0        # against the finest CG P1 run
