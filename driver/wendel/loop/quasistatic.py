@@ -25,7 +25,7 @@ from ..scene import load
 from ..scene.reading import check_size
 from ..scene.schema import Scene
 from .checkpoint import RunFiles, State, committed, save as _save_checkpoint
-from . import first_launch, overlap, separated
+from . import overlap, separated
 from .guard import disk_full as _disk_full, guarded
 from .resume import is_drilling, restart, resume as resume_run, resume_drilling
 from .launch import options, write_tables
@@ -94,7 +94,7 @@ def run_scene(scene: Scene, scene_path: Path, out: Path, smoke: bool = False, pr
         from .drilling import run as run_drilling
         with guarded(files.root):
             return run_drilling(scene, scene_path, files.root, smoke, progress)
-    with guarded(files.root), first_launch.ahead(scene, files):     # FreeFEM starts while gmsh meshes
+    with guarded(files.root):
         if scene.output.png:
             pictures.prestart()        # the renderer starts while the driver meshes (issue 20)
         summary.write_provenance(files.root, Path(scene_path), scene, smoke)
@@ -204,7 +204,7 @@ def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress)
         try:
             with watcher, behind:
                 freefem.run(entry, switches + stop_args + opts, files.fem, ranks=scene.numerics.ranks,
-                            timeout=scene.numerics.timeout, log=files.root / "freefem.log", started=first_launch.take(files))
+                            timeout=scene.numerics.timeout, log=files.root / "freefem.log")
         except freefem.NewtonFailure as exc:
             failure = exc
         finally:
