@@ -49,6 +49,26 @@ def smoke_ball(out: Path, **numerics) -> Path:
     return run_scene(scene, path, out, smoke=True, progress=lambda *_: None)
 
 
+def kill_after_increment(scene: Path, out: Path, increment: int) -> None:
+    """``wendel run SCENE --smoke --out OUT`` in a process of its own, SIGKILLed once its increment
+    ``increment`` is done (the run must still be going then), and ``wendel run --resume OUT`` to its end."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    cmd = [sys.executable, "-m", "wendel.cli", "run"]
+    p = subprocess.Popen(cmd + [str(scene), "--smoke", "--out", str(out)], stdout=subprocess.DEVNULL,
+                         stderr=subprocess.DEVNULL)
+    while p.poll() is None and not (out / "fem" / f"inc-{increment:04d}" / "done").is_file():
+        time.sleep(0.005)
+    assert p.poll() is None, f"the run ended before its increment {increment} was done"
+    p.send_signal(signal.SIGKILL)
+    p.wait()
+    r = subprocess.run(cmd + ["--resume", str(out)], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+
+
 def edit(text: str, old: str, new: str) -> str:
     """``text`` with its first ``old`` replaced by ``new`` (which must be there: a test edits what it means to)."""
     assert old in text, old

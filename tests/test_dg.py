@@ -13,7 +13,7 @@ from wendel.loop import run
 from wendel.results.study import study
 from wendel.scene import SceneError, load
 
-from conftest import WORKFLOWS, edit
+from conftest import WORKFLOWS, edit, kill_after_increment
 
 
 def test_a_dg_scene_compiles_the_dg_module_and_the_elastic_cg_scene_does_not(tmp_path):
@@ -120,10 +120,8 @@ def test_dg_plasticity_follows_hill_with_newton_converging_fast(tmp_path, quiet)
 
 @pytest.mark.parametrize("scene_name", ["cylinder-dg.toml", "cylinder-dg-p2.toml"])
 def test_a_killed_dg_plastic_run_resumes_to_the_same_result(tmp_path, scene_name):
-    import signal
     import subprocess
     import sys
-    import time
 
     import numpy as np
 
@@ -133,14 +131,7 @@ def test_a_killed_dg_plastic_run_resumes_to_the_same_result(tmp_path, scene_name
     scene = str(WORKFLOWS / scene_name)
     assert subprocess.run(cmd + [scene, "--smoke", "--out", str(tmp_path / "ref")], capture_output=True).returncode == 0
     killed = tmp_path / "killed"
-    p = subprocess.Popen(cmd + [scene, "--smoke", "--out", str(killed)], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
-    while p.poll() is None and not (killed / "fem" / "inc-0003" / "done").is_file():
-        time.sleep(0.005)
-    assert p.poll() is None, "the run ended before its third increment"
-    p.send_signal(signal.SIGKILL)
-    p.wait()
-    r = subprocess.run(cmd + ["--resume", str(killed)], capture_output=True, text=True, timeout=300)
-    assert r.returncode == 0, r.stderr
+    kill_after_increment(WORKFLOWS / scene_name, killed, 3)
     rows = [list(csv.DictReader((run_dir / "history.csv").open())) for run_dir in (tmp_path / "ref", killed)]
     assert [r_["newton_iterations"] for r_ in rows[0]] == [r_["newton_iterations"] for r_ in rows[1]]
     for a, b in zip(*rows):
@@ -234,23 +225,14 @@ def test_the_notched_plate_separates_across_its_ligament_and_the_force_drops(tmp
 
 
 def test_a_killed_separating_run_resumes_to_the_same_result(tmp_path):
-    import signal
     import subprocess
     import sys
-    import time
 
     cmd = [sys.executable, "-m", "wendel.cli", "run"]
     scene = str(WORKFLOWS / "dg-separation.toml")
     assert subprocess.run(cmd + [scene, "--smoke", "--out", str(tmp_path / "ref")], capture_output=True).returncode == 0
     killed = tmp_path / "killed"
-    p = subprocess.Popen(cmd + [scene, "--smoke", "--out", str(killed)], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
-    while p.poll() is None and not (killed / "fem" / "inc-0004" / "done").is_file():    # one face open
-        time.sleep(0.005)
-    assert p.poll() is None, "the run ended before its fourth increment"
-    p.send_signal(signal.SIGKILL)
-    p.wait()
-    r = subprocess.run(cmd + ["--resume", str(killed)], capture_output=True, text=True, timeout=300)
-    assert r.returncode == 0, r.stderr
+    kill_after_increment(WORKFLOWS / "dg-separation.toml", killed, 4)         # one face open
     recs = [[json.loads((d / "record.json").read_text()) for d in sorted((run_dir / "fem").glob("inc-*"))]
             for run_dir in (tmp_path / "ref", killed)]
     assert [(r_["newton_iterations"], r_["dg_open_faces"]) for r_ in recs[0]] == \

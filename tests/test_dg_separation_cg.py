@@ -7,10 +7,6 @@ from __future__ import annotations
 
 import csv
 import json
-import signal
-import subprocess
-import sys
-import time
 
 import meshio
 import numpy as np
@@ -20,7 +16,7 @@ from wendel.loop import run
 from wendel.remesh.bodies import body_index
 from wendel.results.vtu import read_array
 
-from conftest import WORKFLOWS
+from conftest import WORKFLOWS, kill_after_increment
 
 
 def _history(root):
@@ -69,17 +65,8 @@ def test_the_notched_plate_separates_is_remeshed_and_goes_on_with_cg_and_resumes
     np.testing.assert_allclose(jump, 4e-3, rtol=1e-9)
 
     # killed (SIGKILL) in the CG part of the run, resumed: the same rows and the same last field
-    cmd = [sys.executable, "-m", "wendel.cli", "run"]
     killed = tmp_path / "killed"
-    proc = subprocess.Popen(cmd + [str(scene), "--smoke", "--out", str(killed)], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE)
-    while proc.poll() is None and not (killed / "fem" / f"inc-{first_cg + 1:04d}" / "done").is_file():
-        time.sleep(0.005)
-    assert proc.poll() is None, "the run ended before the kill"
-    proc.send_signal(signal.SIGKILL)
-    proc.wait()
-    r = subprocess.run(cmd + ["--resume", str(killed)], capture_output=True, text=True, timeout=300)
-    assert r.returncode == 0, r.stderr
+    kill_after_increment(scene, killed, first_cg + 1)
     again = _history(killed)
     assert [(a["increment"], a["load_factor"], a["newton_iterations"]) for a in again] == \
         [(a["increment"], a["load_factor"], a["newton_iterations"]) for a in rows]
