@@ -77,6 +77,41 @@ def test_adiabatic_johnson_cook_bar(tmp_path):
     assert last["jc_clipped_points"] == 0
 
 
+@pytest.mark.parametrize("m", [1.0, 0.7])
+def test_adiabatic_softening_is_solved_with_the_flow(tmp_path, scene_file, m):
+    # the same bar with thermal softening (m = 1: about 19 % at the end; m = 0.7: steeper, infinite slope at Tr). The return mapping solves the heating
+    # T = T_n + beta / (rho c) (sy_n + sy) dp / 2 with the flow (thermal.idp's thermAdPrepare, plasticity.idp's
+    # plastYield), so the softening is in the tangent: Newton converges quadratically, 3 iterations per increment
+    # (measured; 6 when T came from the previous trial, a fixed point), and every increment is the discrete
+    # uniaxial-stress recursion: eps_k = sy / E + p_k, sy = (A + B p^n)(1 - ((T - Tr) / (Tm - Tr))^m) (measured
+    # 6e-15 for m = 1)
+    from scipy.optimize import brentq
+
+    text = (WORKFLOWS / "thermo-adiabatic-bar.toml").read_text().replace("jc_m = 1000.0 ", f"jc_m = {m} ")
+    root = run(scene_file(text, "softening.toml"), smoke=True, out=tmp_path / "r", png=False, progress=lambda *_: None)
+    rows = list(csv.DictReader((root / "history.csv").open()))
+    E_, rho, c, beta, A, B, n, Tr, Tm = 205e9, 7830.0, 477.0, 0.9, 792e6, 510e6, 0.26, 293.15, 1793.0
+    p0, T0, s0 = 0.0, Tr, A
+    for k, row in enumerate(rows, 1):
+        eps = k / len(rows) * 1.0063512195121951
+
+        def sigma(p):   # the yield stress at p with T(p, sigma) solved for sigma
+            Y = A + B * p ** n
+
+            def f(sg):
+                T = T0 + beta / (rho * c) * (s0 + sg) / 2 * (p - p0)
+                return sg - Y * (1 - min(max((T - Tr) / (Tm - Tr), 0.0), 1.0) ** m)
+            return brentq(f, 0.0, Y, xtol=1e-6)
+
+        p = brentq(lambda q: eps - sigma(q) / E_ - q, p0, eps, xtol=1e-15)
+        s = sigma(p)
+        T0, p0, s0 = T0 + beta / (rho * c) * (s0 + s) / 2 * (p - p0), p, s
+        assert float(row["max_temperature"]) == pytest.approx(T0, rel=1e-10), k
+        assert float(row["max_von_mises"]) == pytest.approx(s, rel=1e-10), k
+        assert int(row["newton_iterations"]) <= 4, (k, row["newton_iterations"])
+    assert s < 0.85 * (A + B * p ** n)                  # softened by more than 15 %
+
+
 def test_adiabatic_without_plasticity_is_refused(tmp_path, scene_file):
     text = (WORKFLOWS / "thermo-free.toml").read_text().replace('coupling = "staggered"', 'coupling = "adiabatic"')
     with pytest.raises(ValueError, match=re.escape("it needs a [plasticity] block")):
