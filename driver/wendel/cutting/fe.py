@@ -157,8 +157,9 @@ def fe_scene(scene, travel: float = 1.0) -> Scene:
                     "tool": {"vertices": tool["vertices"], "radii": tool["radii"]}, "friction": friction,
                     "path": {"load_factors": [0.0, 1.0], "x": [0.0, -cut], "y": [0.0, 0.0]}},
         "loading": {"steps": steps, "max_cuts": scene.loading.max_cuts},
-        # newton_maxit: the adiabatic temperature is a fixed point outside the tangent (linear convergence,
-        # factor about 0.5 an iteration, measured): 40 iterations stopped a re-equilibration at 55 um
+        # newton_maxit: room for the contact and friction sets to settle in a re-equilibration (40 stopped one
+        # at 55 um when the adiabatic temperature was still a fixed point outside the tangent; since session 8
+        # the return mapping solves it, plasticity.idp's plastAd)
         "numerics": {"solver": "direct", "newton_tol": 1e-8, "newton_maxit": 100},
         "output": {"png": False, "vtu": True},
         "remesh": remesh,
