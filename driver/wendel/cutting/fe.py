@@ -160,7 +160,9 @@ def fe_scene(scene, travel: float = 1.0) -> Scene:
         # newton_maxit: room for the contact and friction sets to settle in a re-equilibration (40 stopped one
         # at 55 um when the adiabatic temperature was still a fixed point outside the tangent; since session 8
         # the return mapping solves it, plasticity.idp's plastAd)
-        "numerics": {"solver": "direct", "newton_tol": 1e-8, "newton_maxit": 100},
+        # predictor: each increment starts from the last one's motion extrapolated (the tool moves steadily; the
+        # first guess from u_n met the tool 5 um deep: 30-40 % fewer Newton iterations, measured in session 8)
+        "numerics": {"solver": "direct", "newton_tol": 1e-8, "newton_maxit": 100, "predictor": "extrapolate"},
         "output": {"png": False, "vtu": True},
         "remesh": remesh,
     }
