@@ -14,7 +14,8 @@ and record and writes ``cutting.csv`` and ``cutting.json`` in the run folder, an
   and between 1 and 2 h up the rake face from the tip (NaN while the chip is shorter than that);
 - ``shear_angle_deg``: from the chip ratio (:func:`wendel.cutting.chip.shear_angle`; NaN without a chip thickness);
 - ``max_T_primary_K``, ``max_T_secondary_K``: the largest temperature of the primary and the secondary (tool-chip)
-  shear zone (:mod:`wendel.cutting.fe_zones`: within 0.25 h of the shear plane, within 0.2 h of the rake face);
+  shear zone (:mod:`wendel.cutting.fe_zones`: within 0.25 h of the shear plane and more than 0.2 h from the tool;
+  within 0.2 h of the rake face and the edge, above the tip);
 - ``tool_travel_m``, ``max_plastic_strain``, ``max_temperature_K`` (NaN without heat), ``elements``;
 - ``heat_plastic_J``, ``heat_friction_chip_J``, ``heat_friction_tool_J``, ``heat_stored_J``: the run's heat ledger
   for the width b (Taylor-Quinney heat, the frictional heat into the chip and into the tool, the heat stored in
@@ -148,8 +149,9 @@ def report(root: Path, scene, frames: bool = True, travel: float = 1.0) -> list[
         from .fe_steady import cycle_means, gif, steady
         summary["steady"] = steady(rows, STEADY_LENGTH * h / MM)
         summary["zone_temperatures"] = {"cycle_means": cycle_means(rows, ("max_T_primary_K", "max_T_secondary_K")),
-                                        "zones": "primary: within 0.25 h of the shear plane; secondary: within "
-                                                 "0.2 h of the rake face (wendel.cutting.fe_zones)"}
+                                        "zones": "primary: within 0.25 h of the shear plane, more than 0.2 h "
+                                                 "from the tool; secondary: within 0.2 h of the rake face and the "
+                                                 "edge, above the tip (wendel.cutting.fe_zones)"}
         if frames:
             gif(root / "frames", root / "chip.gif", every=2)
     try:

@@ -7,17 +7,18 @@ The zones are geometric, measured on the current positions (mm) of the increment
   the flank side (the machined surface) is in neither zone;
 - **primary zone** (the chip root's shear band): the material within ``PRIMARY * h`` of the shear plane, the
   segment from the tip ahead of the tool up to the top of the uncut layer (y = h) at the shear angle phi
-  (from the increment's chip ratio; Oxley's phi, or 20 deg, while the chip has no thickness yet), the
-  secondary zone left out.
+  (from the increment's chip ratio; Oxley's phi, or 20 deg, while the chip has no thickness yet), above the
+  tip (the rake side), the material within ``SECONDARY * h`` of the tool left out (the edge and the rake face:
+  the secondary zone; below the tip the flank's, in neither zone).
 
 Temperatures: the nodal field ``T`` of a conducting cut, or the cell field ``T`` (at the cells' centroids) of an
 adiabatic one. NaN where a zone holds no point.
 
->>> pts = np.array([[0.0, 0.001], [-0.1, 0.05], [-0.5, 0.05], [0.05, 0.1]])
+>>> pts = np.array([[0.0, 0.001], [-0.1, 0.05], [-0.5, 0.05], [0.05, 0.1], [-0.02, -0.005]])
 >>> outline = np.array([[0.0, 0.0], [0.5, 1.0], [1.0, 1.0], [1.0, 0.0]])  # a wedge: tip at the origin
 >>> z = zones(pts, outline, np.zeros(2), math.radians(0.0), 0.15, math.radians(30))
 >>> z["secondary"].tolist(), z["primary"].tolist()
-([True, False, False, True], [False, True, False, False])
+([True, False, False, True, False], [False, True, False, False, False])
 """
 
 from __future__ import annotations
@@ -48,12 +49,13 @@ def zones(points: np.ndarray, outline: np.ndarray, tip: np.ndarray, rake: float,
     """Boolean masks ``secondary`` and ``primary`` of ``points`` (see the module); the tool moves in -x, its
     rake face runs up along (sin rake, cos rake) from the ``tip``."""
     along = (points - tip) @ np.array([math.sin(rake), math.cos(rake)])
-    secondary = (distance_to_outline(points, outline) <= SECONDARY * h) & (along >= 0)
+    near = distance_to_outline(points, outline) <= SECONDARY * h
+    secondary = near & (along >= 0)
     e = np.array([-math.cos(phi), math.sin(phi)])        # up the shear plane, ahead of the tool
     n = np.array([e[1], -e[0]])
     s = (points - tip) @ e
     primary = (s >= 0) & (s <= h / max(math.sin(phi), 1e-3)) & (np.abs((points - tip) @ n) <= PRIMARY * h) \
-        & ~secondary
+        & ~near & (along >= 0)
     return {"secondary": secondary, "primary": primary}
 
 
