@@ -12,6 +12,11 @@ class StepCutError(RuntimeError):
     """An increment failed after every allowed step cut; accepted increments are on disk."""
 
 
+class RemeshFailure(StepCutError):
+    """gmsh made no mesh of the deformed body at a remesh (a run failure, exit 1, not bad input); the accepted
+    increments are on disk."""
+
+
 class Interrupted(KeyboardInterrupt):
     """Ctrl-C or SIGTERM stopped the run in ``root``; FreeFEM was stopped too and the run can resume."""
 
