@@ -9,12 +9,15 @@ of modules that exist and are tested on their own:
   in -x by ``cutting.cut_length`` over the load factor 0 -> 1, Coulomb friction ``cutting.friction`` on
   the whole ``free_surface`` (top of the layer and the step face; ``edp/lib/friction.idp``), capped at
   ``cutting.shear_cap`` when given;
-- Johnson-Cook plasticity with its rate term (time per unit load factor = cut length / speed) and, when
-  ``thermal.coupling = "adiabatic"``, its thermal softening: the temperature is an internal variable of the
+- Johnson-Cook plasticity with its rate term (time per unit load factor = cut length / speed) and its
+  thermal softening. ``thermal.coupling = "adiabatic"``: the temperature is an internal variable of the
   quadrature points heated by beta (Taylor-Quinney) of the plastic work (``edp/lib/thermal.idp``'s
-  adiabatic coupling, allowed with updated-Lagrangian kinematics when alpha = 0: the thermal expansion is
-  left out, and so is the frictional heat, which has no heat equation to enter). Other couplings: the cut
-  is isothermal (at T_room; conduction with UL is not written);
+  adiabatic coupling); ``"staggered"`` or ``"monolithic"``: the heat equation on the current body
+  (``edp/lib/kinematics-thermal.idp``; no advection term: the mesh moves with the material) with the same
+  Taylor-Quinney heat and the rake face's frictional heat, ``cutting.heat_to_chip`` of the frictional work
+  into the chip (``cutting.frictional_heat``; the rest goes to the rigid tool, which is not meshed, and leaves
+  the model), every boundary insulated unless ``[thermal.boundary]`` says otherwise. k and c are constant
+  (:func:`properties`); thermal expansion is left out (alpha = 0);
 - a remesh of the deformed body every ``cutting.remesh_every`` increments (and whenever the element
   quality falls below 0.1), uniform size ``geometry.fine * geometry.h`` or, with ``cutting.edge_size``,
   graded from that size at the edge (:func:`size_zones`), with transfer of the UL state
@@ -167,12 +170,50 @@ def fe_scene(scene, travel: float = 1.0) -> Scene:
         "remesh": remesh,
     }
     th = scene.thermal
-    if th is not None and th.coupling == "adiabatic":      # heating by plastic work at the quadrature points
-        data["thermal"] = {"k": th.k, "rho": th.rho * 1e-6, "c": th.c, "alpha": 0.0, "T_ref": th.T_ref,
-                           "beta": th.beta, "coupling": "adiabatic", "duration": plasticity["load_time"]}
+    if th is not None:
+        k, cap = properties(scene)
+        # adiabatic: heating by plastic work at the quadrature points; monolithic / staggered: the heat equation
+        # on the current body (kinematics-thermal.idp), every boundary insulated unless [thermal.boundary] says
+        # otherwise (the heat of a 0.1-0.2 ms cut diffuses sqrt(a t) ~ 40-60 um, the block is 0.5 mm deep)
+        data["thermal"] = {"k": k, "rho": th.rho * 1e-6, "c": cap, "alpha": 0.0, "T_ref": th.T_ref,
+                           "beta": th.beta, "coupling": th.coupling, "duration": plasticity["load_time"]}
         if th.T_initial is not None:
             data["thermal"]["T_initial"] = th.T_initial
+        if th.coupling != "adiabatic":
+            data["thermal"]["boundary"] = {name: _heat_boundary(b) for name, b in th.boundary.items()}
+            # the frictional work of the rake face: heat_to_chip of it into the chip, the rest into the tool, which
+            # is rigid and not meshed (it leaves the model: friction_heat_tool in record.json)
+            friction["heat_fraction"] = c.heat_to_chip if c.frictional_heat is not False else 0.0
     return Scene.model_validate(data)
+
+
+def properties(scene) -> tuple[float, float]:
+    """k [W/m/K] and c [J/kg/K] of the FE cut's heat equation: constant, at ``cutting.fe_properties_T`` from
+    thermal.k, thermal.c and the slopes, or as written.
+
+    >>> from wendel.freefem import ROOT
+    >>> from wendel.scene import load
+    >>> s = load(ROOT / "workflows" / "cutting-aisi1045.toml")
+    >>> properties(s)
+    (52.61, 420.0)
+    >>> s.cutting.fe_properties_T = 773.15      # 500 C: Lalwani et al.'s k = 52.61 - 0.0281 T, c = 420 + 0.504 T
+    >>> [round(v, 3) for v in properties(s)]
+    [38.56, 672.0]
+    """
+    c, th = scene.cutting, scene.thermal
+    if c.fe_properties_T is None:
+        return th.k, th.c
+    dT = c.fe_properties_T - c.properties_T0
+    return th.k + c.k_slope * dT, th.c + c.c_slope * dT
+
+
+def _heat_boundary(b) -> dict:
+    """A [thermal.boundary] condition in the FE scene's units (mm: a flux W/m^2 = 1e-3 mW/mm^2)."""
+    d = b.model_dump(exclude_none=True)
+    for key in ("flux", "h"):
+        if key in d:
+            d[key] = d[key] * 1e-3
+    return d
 
 
 def forces(record: dict, width: float) -> tuple[float, float]:

@@ -12,7 +12,14 @@ and record and writes ``cutting.csv`` and ``cutting.json`` in the run folder, an
   (``friction_state`` > 0) [m];
 - ``chip_thickness_m``: :func:`wendel.cutting.chip.chip_thickness` of the free boundary nodes above 1.1 h
   and between 1 and 2 h up the rake face from the tip (NaN while the chip is shorter than that);
-- ``tool_travel_m``, ``max_plastic_strain``, ``max_temperature_K`` (adiabatic cuts; NaN otherwise), ``elements``.
+- ``shear_angle_deg``: from the chip ratio (:func:`wendel.cutting.chip.shear_angle`; NaN without a chip thickness);
+- ``max_T_primary_K``, ``max_T_secondary_K``: the largest temperature of the primary and the secondary (tool-chip)
+  shear zone (:mod:`wendel.cutting.fe_zones`: within 0.25 h of the shear plane and more than 0.2 h from the tool;
+  within 0.2 h of the rake face and the edge, above the tip);
+- ``tool_travel_m``, ``max_plastic_strain``, ``max_temperature_K`` (NaN without heat), ``elements``;
+- ``heat_plastic_J``, ``heat_friction_chip_J``, ``heat_friction_tool_J``, ``heat_stored_J``: the run's heat ledger
+  for the width b (Taylor-Quinney heat, the frictional heat into the chip and into the tool, the heat stored in
+  the workpiece; NaN where the record has none).
 
 ``cutting.json`` adds the Oxley prediction of the same scene (``wendel oxley``), the last increment's
 values beside it and the steady state (:mod:`wendel.cutting.fe_steady`, a window of one h of travel);
@@ -33,7 +40,12 @@ from .fe import MM, fe_scene, forces, tool_at_start
 
 STEADY_LENGTH = 1.0    # the steady-state window: one uncut chip thickness of travel (fe_steady)
 COLUMNS = ["increment", "load_factor", "tool_travel_m", "Fc_N", "Ft_N", "chip_rise_m", "contact_length_m",
-           "chip_thickness_m", "max_plastic_strain", "max_temperature_K", "elements"]
+           "chip_thickness_m", "shear_angle_deg", "max_plastic_strain", "max_temperature_K", "max_T_primary_K",
+           "max_T_secondary_K", "heat_plastic_J", "heat_friction_chip_J", "heat_friction_tool_J", "heat_stored_J",
+           "elements"]
+LEDGER = {"heat_plastic_J": "heat_plastic", "heat_friction_chip_J": "friction_heat_body",
+          "heat_friction_tool_J": "friction_heat_tool", "heat_stored_J": "thermal_energy_change"}
+"""cutting.csv's heat columns and the record's keys (mJ per mm of width in the FE scene's units)."""
 
 
 def run_cut(scene, scene_path: Path, out: Path, smoke: bool, progress=print, frames: bool = True) -> Path:
@@ -88,6 +100,14 @@ def report(root: Path, scene, frames: bool = True, travel: float = 1.0) -> list[
     start = tool_at_start(c, extra["length"] - extra["pre_cut"])
     tip0 = np.array(start["tip"])
     history = list(csv.DictReader((root / "history.csv").open()))
+    from .fe_frames import rounded_outline
+    from .fe_zones import PHI_DEFAULT, zone_temperatures
+    outline0 = rounded_outline(start["vertices"], start["radii"], per_arc=16)
+    try:
+        from .scene import predict
+        phi_oxley = predict(scene).phi
+    except (ValueError, ArithmeticError):
+        phi_oxley = math.radians(PHI_DEFAULT)
     rows = []
     for rec in history:
         inc = int(rec["increment"])
@@ -100,11 +120,18 @@ def report(root: Path, scene, frames: bool = True, travel: float = 1.0) -> list[
         shift = np.array([float(rec.get("tool_x") or 0.0), float(rec.get("tool_y") or 0.0)])
         got = measure(points, cells, np.asarray(m.point_data["friction_state"]).ravel(), tip0 + shift, rake, h)
         fc, ft = forces(rec, c.width)
+        t2 = got["chip_thickness"]
+        phi = chip.shear_angle(h, t2, rake) if t2 == t2 and t2 > 0 else float("nan")
+        temps = zone_temperatures(m, outline0 + shift, tip0 + shift, rake, h, phi if phi == phi else phi_oxley)
+        ledger = {k: _num(rec.get(v)) * c.width for k, v in LEDGER.items()}     # mJ/mm * m = J
+        if fe.thermal is None or fe.thermal.coupling == "adiabatic":             # no heat equation takes it
+            ledger["heat_friction_chip_J"] = ledger["heat_friction_tool_J"] = float("nan")
         rows.append({"increment": inc, "load_factor": float(rec["load_factor"]), "tool_travel_m": -shift[0] / MM,
                      "Fc_N": fc, "Ft_N": ft, "chip_rise_m": got["chip_rise"] / MM,
                      "contact_length_m": got["contact_length"] / MM, "chip_thickness_m": got["chip_thickness"] / MM,
+                     "shear_angle_deg": math.degrees(phi),
                      "max_plastic_strain": float(rec.get("max_plastic_strain") or 0.0),
-                     "max_temperature_K": float(rec.get("max_temperature") or "nan"),
+                     "max_temperature_K": float(rec.get("max_temperature") or "nan"), **temps, **ledger,
                      "elements": int(float(rec["elements"]))})
         if frames:
             from .fe_frames import frame
@@ -115,10 +142,16 @@ def report(root: Path, scene, frames: bool = True, travel: float = 1.0) -> list[
         w = csv.DictWriter(f, fieldnames=COLUMNS)
         w.writeheader()
         w.writerows(rows)
-    summary = {"last": rows[-1] if rows else None, "width_m": c.width, "adiabatic": fe.thermal is not None}
+    coupling = fe.thermal.coupling if fe.thermal is not None else None
+    summary = {"last": rows[-1] if rows else None, "width_m": c.width, "adiabatic": coupling == "adiabatic",
+               "thermal_coupling": coupling}
     if rows:
-        from .fe_steady import gif, steady
+        from .fe_steady import cycle_means, gif, steady
         summary["steady"] = steady(rows, STEADY_LENGTH * h / MM)
+        summary["zone_temperatures"] = {"cycle_means": cycle_means(rows, ("max_T_primary_K", "max_T_secondary_K")),
+                                        "zones": "primary: within 0.25 h of the shear plane, more than 0.2 h "
+                                                 "from the tool; secondary: within 0.2 h of the rake face and the "
+                                                 "edge, above the tip (wendel.cutting.fe_zones)"}
         if frames:
             gif(root / "frames", root / "chip.gif", every=2)
     try:
@@ -128,3 +161,11 @@ def report(root: Path, scene, frames: bool = True, travel: float = 1.0) -> list[
         summary["oxley"] = {"refused": str(exc)}
     (root / "cutting.json").write_text(json.dumps(summary, indent=1, default=float))
     return rows
+
+
+def _num(v) -> float:
+    """A record's value as a float, NaN where it is missing or empty."""
+    try:
+        return float(v)
+    except (TypeError, ValueError):
+        return float("nan")

@@ -49,9 +49,9 @@ def _split(rows: list[dict]) -> list[list[dict]]:
     return cycles
 
 
-def cycle_means(rows: list[dict]) -> list[dict]:
+def cycle_means(rows: list[dict], series: tuple = SERIES) -> list[dict]:
     """Per remesh cycle (the last one left out when it is shorter than the others): the mean travel and the
-    means of the series (finite values only)."""
+    means of the ``series`` (finite values only)."""
     out = []
     cycles = _split(rows)
     if len(cycles) > 1 and len(cycles[-1]) < np.median([len(c) for c in cycles[:-1]]):
@@ -59,7 +59,7 @@ def cycle_means(rows: list[dict]) -> list[dict]:
     for c in cycles:
         m = {"tool_travel_m": float(np.mean([r["tool_travel_m"] for r in c])), "increments": len(c)}
         w = _weights(rows, c)
-        for k in SERIES:
+        for k in series:
             v = np.array([r[k] for r in c], dtype=float)
             ok = np.isfinite(v)
             m[k] = float(np.average(v[ok], weights=w[ok])) if ok.any() and w[ok].sum() > 0 else \

@@ -28,3 +28,17 @@ def remesh_again(scene, files, state, progress) -> bool:
     from .step import maybe_remesh
     maybe_remesh(scene, files, state, 2, progress, again=tried + 1)
     return True
+
+
+def made_or_failed(remesh, k: int, inc: int, lf: float, quality: dict, root):
+    """``remesh()`` (remesh ``k`` after increment ``inc``), its failure to make a mesh of the deformed body (gmsh's
+    own errors, numpy's "need at least one array to concatenate" on an empty mesh) turned into a
+    :class:`wendel.errors.RemeshFailure` (a run failure, exit 1) that names the remesh, the increment and its element
+    ``quality`` and says what to do; a full disk stays what it is."""
+    try:
+        return remesh()
+    except OSError:
+        raise
+    except Exception as exc:
+        from ..errors import RemeshFailure
+        raise RemeshFailure.at(k, inc, lf, quality, root, exc) from exc

@@ -31,7 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .again import AGAIN
+from .again import AGAIN, made_or_failed
 from . import quality       # mesher (meshio, gmsh) and transfer (scipy) when a run remeshes: a run without
                             # remeshing judges its mesh only and does not pay their imports
 from ..results import vtu
@@ -283,12 +283,11 @@ def maybe_remesh(scene, files, state, dimension: int, progress, again: int = 0) 
     ubase_old = vtu.read_array(files.root / seg["ubase"]) if seg["ubase"] else None
     progress(f"  increment {inc}: min quality {q.get('min_quality', float('nan')):.3g}"
              f"{' (asked by remesh.at)' if not poor else ''}: remeshing")
-    rep = remesh_state(files.fem / f"inc-{inc:04d}", files.root / seg["mesh"], ubase_old, dimension,
-                                 files.root / mesh_new, files.root / state_dir, h, r.h_min or h / 3, r.indicator,
-                                 mu=scene.material.E / (2 * (1 + scene.material.nu)),
-                                 axisymmetric=scene.elasticity.plane == "axisymmetric",
-                                 zones=zones_at(r, files.fem / f"inc-{inc:04d}"),
-                                 algorithm_2d=AGAIN[again - 1] if again else None)
+    rep = made_or_failed(lambda: remesh_state(
+        files.fem / f"inc-{inc:04d}", files.root / seg["mesh"], ubase_old, dimension, files.root / mesh_new,
+        files.root / state_dir, h, r.h_min or h / 3, r.indicator, mu=scene.material.E / (2 * (1 + scene.material.nu)),
+        axisymmetric=scene.elasticity.plane == "axisymmetric", zones=zones_at(r, files.fem / f"inc-{inc:04d}"),
+        algorithm_2d=AGAIN[again - 1] if again else None), k, inc, lf, q, files.root)
     rep.update({"remesh": k, "after_increment": inc, "load_factor": lf, "dimension": dimension,
                 "algorithm_2d_tries": again})
     state.remeshes.append(rep)

@@ -8,8 +8,8 @@ material comes from the scene's other tables: Johnson-Cook constants from ``[pla
 
 ``wendel oxley SCENE.toml`` runs the analytic model from these tables. The finite-element chip
 formation: ``wendel run`` of a cutting scene solves the mechanics scene that :mod:`wendel.cutting.fe`
-derives from it (updated-Lagrangian kinematics, frictional polygon tool, Johnson-Cook, remeshing; an
-isothermal prototype, :data:`FE_READY`).
+derives from it (updated-Lagrangian kinematics, frictional polygon tool, Johnson-Cook with adiabatic heating
+or heat conduction and frictional heat, remeshing; :data:`FE_READY`).
 
 >>> c = Cutting(speed=200 / 60, uncut_thickness=0.15e-3, width=1.6e-3, rake=-7.0)
 >>> c.clearance, c.oxley.properties
@@ -25,7 +25,7 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 from . import Block, choice, register
 
 FE_READY = True
-"""Whether the finite-element chip formation exists: an isothermal prototype (:mod:`wendel.cutting.fe`)."""
+"""Whether the finite-element chip formation exists (:mod:`wendel.cutting.fe`)."""
 
 PROPERTY_TEMPERATURES = ("shear-plane", "chip", "interface")
 PropertyTemperature = choice(PROPERTY_TEMPERATURES, "property temperature")
@@ -77,6 +77,15 @@ class Cutting(BaseModel):
                                        "edge [m], graded to geometry.fine * geometry.h around the primary shear "
                                        "zone and the rake contact and to twice that elsewhere "
                                        "(wendel.cutting.fe.size_zones); default: uniform geometry.fine * geometry.h")
+    frictional_heat: Optional[bool] = Field(None, description="FE: the rake face's frictional work heats the chip "
+                                            "(heat_to_chip of it; the rest goes to the rigid tool, which is not "
+                                            "meshed, and leaves the model); needs a heat equation (thermal.coupling "
+                                            "monolithic or staggered); default: on with a heat equation, off when "
+                                            "adiabatic")
+    fe_properties_T: Optional[float] = Field(None, gt=0, description="FE: temperature at which the heat equation's "
+                                             "k and c (and rho c of the adiabatic heating) are taken from thermal.k, "
+                                             "thermal.c and k_slope, c_slope (the FE's k and c are constant) [K]; "
+                                             "default: thermal.k and thermal.c as written (at properties_T0)")
     volumetric: Literal["cell", "fbar"] = Field("cell", description="FE: the updated-Lagrangian volume change, "
                                                 "per cell (P1, locks in the isochoric plastic flow) or F-bar "
                                                 "(kinematics.volumetric)")
@@ -106,8 +115,18 @@ def check(block: Cutting, scene) -> None:
     plast = getattr(scene, "plasticity", None)
     if plast is None or plast.law != "johnson-cook":
         raise ValueError("cutting needs a [plasticity] table with law = \"johnson-cook\" (the work material)")
-    if getattr(scene, "thermal", None) is None:
+    th = getattr(scene, "thermal", None)
+    if th is None:
         raise ValueError("cutting needs a [thermal] table (density, conductivity, heat capacity of the work material)")
+    if block.frictional_heat and th.coupling == "adiabatic":
+        raise ValueError("cutting.frictional_heat = true needs a heat equation to receive it: thermal.coupling = "
+                         "\"staggered\" or \"monolithic\" (\"adiabatic\" heats the quadrature points by plastic work only)")
+    if block.fe_properties_T is not None:
+        k = th.k + block.k_slope * (block.fe_properties_T - block.properties_T0)
+        c = th.c + block.c_slope * (block.fe_properties_T - block.properties_T0)
+        if not (k > 0 and c > 0):
+            raise ValueError(f"cutting.fe_properties_T ({block.fe_properties_T:g} K) gives k = {k:g} W/m/K, "
+                             f"c = {c:g} J/kg/K from thermal.k, thermal.c and the slopes: both must be > 0")
     g = scene.geometry
     if g.builder == "orthogonal-cutting":
         uncut = (g.model_extra or {}).get("uncut")
