@@ -16,7 +16,9 @@ and record and writes ``cutting.csv`` and ``cutting.json`` in the run folder, an
 
 ``cutting.json`` adds the Oxley prediction of the same scene (``wendel oxley``), the last increment's
 values beside it and the steady state (:mod:`wendel.cutting.fe_steady`, a window of one h of travel);
-``chip.gif`` animates every second frame.
+``chip.gif`` animates every second frame. ``summary.json["outputs"]`` gets the means over the last h of travel
+(``steady_Fc_N``, ``steady_Ft_N``, ``steady_chip_m``, their cycle-mean spreads and drifts:
+:func:`wendel.cutting.fe_steady.window`), the numbers a campaign (``wendel sweep``) tabulates and plots.
 """
 
 from __future__ import annotations
@@ -127,4 +129,9 @@ def report(root: Path, scene, frames: bool = True, travel: float = 1.0) -> list[
     except (ValueError, ArithmeticError) as exc:         # outside the model's domain: say so, keep the FE
         summary["oxley"] = {"refused": str(exc)}
     (root / "cutting.json").write_text(json.dumps(summary, indent=1, default=float))
+    if rows and (root / "summary.json").is_file():        # the steady figures for a campaign (wendel sweep's table)
+        from .fe_steady import window
+        s = json.loads((root / "summary.json").read_text())
+        s["outputs"] = {**(s.get("outputs") or {}), **window(rows, STEADY_LENGTH * h / MM)}
+        (root / "summary.json").write_text(json.dumps(s, indent=1, default=float))
     return rows
