@@ -30,5 +30,5 @@ def cutting_kienzle(quick: bool, workdir: Path) -> list[dict]:
     cuts = fe_campaign.points(root)
     fits = fe_campaign.compare(cuts, "aisi1045")
     fe_campaign.plot(workdir.parents[1] / "cutting-kienzle.png", cuts, fits,
-                     "AISI 1045, FE cuts (graded mesh, edge r/2) against Oxley and the catalogues")
+                     "AISI 1045: FE cuts (edge r/2, last h of 2.67 h) against Oxley, catalogues")
     return [{"kind": "cut", **r} for r in cuts] + [{"kind": "fit", **f} for f in fits]

@@ -95,7 +95,7 @@ def plot(path: Path, rows: list[dict], fits: list[dict], title: str) -> Path:
 
     ok = [r for r in rows if r["status"] == "ok"]
     groups = sorted({tuple(r[k] for k in GROUP) for r in ok})
-    fig, axes = plt.subplots(1, max(len(groups), 1), figsize=(5.2 * max(len(groups), 1), 4.4), squeeze=False)
+    fig, axes = plt.subplots(1, max(len(groups), 1), figsize=(6.2 * max(len(groups), 1), 4.8), squeeze=False)
     for ax, g in zip(axes[0], groups):
         pts = sorted((r for r in ok if tuple(r[k] for k in GROUP) == g), key=lambda r: r["h"])
         b = pts[0]["b"]
@@ -109,6 +109,11 @@ def plot(path: Path, rows: list[dict], fits: list[dict], title: str) -> Path:
             label = f["source"] if f["source"] in styles else f["source"].split(":")[0]
             ax.loglog(line, b * 1e3 * f["kc11_N_per_mm2"] * line ** (1 - f["mc"]), ls, color=color, lw=1.2,
                       label=f"{label}: k_c1.1 {f['kc11_N_per_mm2']:.0f} N/mm^2, m_c {f['mc']:.2f}")
+        from matplotlib.ticker import ScalarFormatter
+        for axis in (ax.xaxis, ax.yaxis):
+            axis.set_major_formatter(ScalarFormatter())
+            axis.set_minor_formatter(ScalarFormatter())
+        ax.tick_params(which="minor", labelsize=6)
         ax.set_xlabel("uncut chip thickness h [mm]")
         ax.set_ylabel(f"F_c [N] (b = {b * 1e3:g} mm)")
         ax.set_title(f"{g[0]:g} m/min, rake {g[1]:g} deg", fontsize=10)
