@@ -59,6 +59,26 @@ def run_cut(scene, scene_path: Path, out: Path, smoke: bool, progress=print, fra
     return root
 
 
+def report_resumed(root: Path, progress=print) -> Path:
+    """The cutting report of a cut that ``wendel run --resume`` finished (a sweep resumes interrupted runs so): the run
+    folder's scene.toml is the cutting scene; the share of the cut (a smoke cut is its first increments) is read
+    from the FE scene that was solved. Nothing for a run folder of any other scene. Returns ``root``."""
+    from ..scene import SceneError, load
+    root = Path(root)
+    try:
+        scene = load(root / "scene.toml")
+    except (SceneError, OSError, ValueError):
+        return root
+    if getattr(scene, "cutting", None) is None:
+        return root
+    solved = json.loads((root / "scene.resolved.json").read_text())["contact"]["path"]["x"][-1]
+    travel = solved / fe_scene(scene).contact.path.x[-1]
+    rows = report(root, scene, frames=True, travel=travel)
+    if rows:
+        progress(f"  cut {rows[-1]['tool_travel_m'] * 1e3:.4g} mm: F_c = {rows[-1]['Fc_N']:.4g} N (cutting.csv, frames/)")
+    return root
+
+
 def _boundary_nodes(cells: np.ndarray) -> np.ndarray:
     from ..remesh.mesher import boundary_facets
     return np.unique(boundary_facets(cells))
