@@ -68,3 +68,20 @@ def test_fit_of_a_two_cut_sweep(tmp_path):
         assert math.isclose(f["fe_kc11_difference"], fe[0]["kc11_N_per_mm2"] / f["kc11_N_per_mm2"] - 1)
     png = fe_campaign.plot(tmp_path / "kienzle.png", cuts, fits, "test")
     assert png.stat().st_size > 1000
+
+
+def test_a_resumed_cut_writes_its_report(tmp_path):
+    """A cut killed after its 2nd increment and finished by `wendel run --resume` (as a sweep resumes it) writes
+    cutting.csv and the steady figures into summary.json like an uninterrupted one."""
+    import json
+
+    from conftest import edit, kill_after_increment
+
+    scene = tmp_path / "cut.toml"
+    scene.write_text(edit((WORKFLOWS / "cutting-aisi1045.toml").read_text(), "length = 1.8e-3", "length = 1.2e-3"))
+    out = tmp_path / "run"
+    kill_after_increment(scene, out, 2)
+    rows = list(csv.DictReader(open(out / "cutting.csv")))
+    assert len(rows) == 4 and math.isclose(float(rows[-1]["tool_travel_m"]), 20e-6, rel_tol=1e-6)   # smoke: 4 x 5 um
+    got = json.loads((out / "summary.json").read_text())["outputs"]
+    assert got["steady_Fc_N"] > got["steady_Ft_N"] > 0 and math.isclose(got["steady_window_to_m"], 20e-6, rel_tol=1e-6)
