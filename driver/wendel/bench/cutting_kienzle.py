@@ -1,8 +1,8 @@
 """``wendel bench cutting-kienzle``: Kienzle's k_c1.1 and m_c of AISI 1045 from FE cuts (issue 17).
 
 Runs the campaign ``workflows/campaigns/cutting-kienzle.toml`` with ``wendel sweep`` (local; its folder
-results/sweeps/cutting-kienzle/, so a sweep run or interrupted before is resumed, not repeated: about 30 core
-minutes from scratch) and fits F_c = b k_c1.1 h^(1 - m_c) to each cut's steady F_c (the mean over its last h of
+results/sweeps/cutting-kienzle/, so a sweep run or interrupted before is resumed, not repeated, and a failed cut tried
+again: about 40 core minutes from scratch) and fits F_c = b k_c1.1 h^(1 - m_c) to each cut's steady F_c (the mean over its last h of
 travel) per (speed, rake), beside the Oxley model's fit at the same conditions and the catalogue constants
 (:mod:`wendel.cutting.fe_campaign`). Rows: one per cut (``kind = "cut"``: F_c FE and Oxley, the window, the
 spread and drift of the remesh-cycle means in it) and one per fit (``kind = "fit"``); the picture
