@@ -94,6 +94,7 @@ def main(argv: list[str] | None = None) -> int:
                    "  cutting-steady (the FE cut to 1.2 mm, about 20 minutes),\n"
                    "  cutting-heat (the FE cut to 400 um adiabatic and with conduction, about 20 minutes),\n"
                    "  cutting-ti (the titanium FE cut on the graded mesh, about 10 minutes),\n"
+                   "  cutting-kienzle (the FE Kienzle campaign: 8 cuts by wendel sweep, about 40 core minutes),\n"
                    "  drilling-3d (the 3D deep bore, all 50 removal steps, about 7 minutes),\n"
                    "  necking-fine (the necking bar on a finer and on remeshed meshes, about 4 minutes)")
     p.add_argument("--quick", action="store_true", help="small sizes only")

@@ -23,7 +23,9 @@ and record and writes ``cutting.csv`` and ``cutting.json`` in the run folder, an
 
 ``cutting.json`` adds the Oxley prediction of the same scene (``wendel oxley``), the last increment's
 values beside it and the steady state (:mod:`wendel.cutting.fe_steady`, a window of one h of travel);
-``chip.gif`` animates every second frame.
+``chip.gif`` animates every second frame. ``summary.json["outputs"]`` gets the means over the last h of travel
+(``steady_Fc_N``, ``steady_Ft_N``, ``steady_chip_m``, their cycle-mean spreads and drifts:
+:func:`wendel.cutting.fe_steady.window`), the numbers a campaign (``wendel sweep``) tabulates and plots.
 """
 
 from __future__ import annotations
@@ -66,6 +68,26 @@ def run_cut(scene, scene_path: Path, out: Path, smoke: bool, progress=print, fra
         progress(f"  cut {r['tool_travel_m'] * 1e3:.4g} mm: F_c = {r['Fc_N']:.4g} N, F_t = {r['Ft_N']:.4g} N, "
                  f"chip rise {r['chip_rise_m'] * 1e3:.4g} mm, contact length {r['contact_length_m'] * 1e3:.4g} mm "
                  f"(cutting.csv, frames/)")
+    return root
+
+
+def report_resumed(root: Path, progress=print) -> Path:
+    """The cutting report of a cut that ``wendel run --resume`` finished (a sweep resumes interrupted runs so): the run
+    folder's scene.toml is the cutting scene; the share of the cut (a smoke cut is its first increments) is read
+    from the FE scene that was solved. Nothing for a run folder of any other scene. Returns ``root``."""
+    from ..scene import SceneError, load
+    root = Path(root)
+    try:
+        scene = load(root / "scene.toml")
+    except (SceneError, OSError, ValueError):
+        return root
+    if getattr(scene, "cutting", None) is None:
+        return root
+    solved = json.loads((root / "scene.resolved.json").read_text())["contact"]["path"]["x"][-1]
+    travel = solved / fe_scene(scene).contact.path.x[-1]
+    rows = report(root, scene, frames=True, travel=travel)
+    if rows:
+        progress(f"  cut {rows[-1]['tool_travel_m'] * 1e3:.4g} mm: F_c = {rows[-1]['Fc_N']:.4g} N (cutting.csv, frames/)")
     return root
 
 
@@ -160,6 +182,11 @@ def report(root: Path, scene, frames: bool = True, travel: float = 1.0) -> list[
     except (ValueError, ArithmeticError) as exc:         # outside the model's domain: say so, keep the FE
         summary["oxley"] = {"refused": str(exc)}
     (root / "cutting.json").write_text(json.dumps(summary, indent=1, default=float))
+    if rows and (root / "summary.json").is_file():        # the steady figures for a campaign (wendel sweep's table)
+        from .fe_steady import window
+        s = json.loads((root / "summary.json").read_text())
+        s["outputs"] = {**(s.get("outputs") or {}), **window(rows, STEADY_LENGTH * h / MM)}
+        (root / "summary.json").write_text(json.dumps(s, indent=1, default=float))
     return rows
 
 

@@ -102,6 +102,39 @@ def steady(rows: list[dict], length: float, tol: float = 0.02) -> dict:
             "cycle_means": cyc, "last_window_spreads": last, "last_window_trends": trend}
 
 
+def window(rows: list[dict], length: float) -> dict:
+    """The cut's figures for a campaign's table (``summary.json["outputs"]``, read by ``wendel sweep``): over the
+    last ``length`` [m] of travel, the mean of each series over the increments weighted by the travel each covers
+    (re-equilibrations left out: a force's mean is the work over the travel), ``steady_Fc_N``, ``steady_Ft_N``,
+    ``steady_chip_m``; the spread (max - min) / mean of the remesh-cycle means inside the window
+    (``*_spread``, NaN with fewer than two) and their drift over the window (``*_trend``, :func:`_trend`); the
+    window [m] and its number of cycles.
+
+    >>> rows = [{"tool_travel_m": t * 1e-6, "Fc_N": f, "Ft_N": 50.0, "chip_thickness_m": 2e-4}
+    ...         for t, f in ((5, 100.0), (10, 300.0), (10, 50.0), (15, 200.0), (20, 200.0))]
+    >>> w = window(rows, 10e-6)       # 10-20 um: 5 um at 200 N, 5 um at 200 N (the re-equilibration left out)
+    >>> round(w["steady_Fc_N"], 6), round(w["steady_window_from_m"] * 1e6, 6)
+    (200.0, 10.0)
+    """
+    t = np.array([r["tool_travel_m"] for r in rows], dtype=float)
+    hi = float(t[-1])
+    lo = hi - length
+    w = np.diff(t, prepend=0.0)
+    inc = (t > lo + 1e-12) & (w > 1e-12)
+    cyc = [c for c in cycle_means(rows) if c["tool_travel_m"] > lo]
+    out = {"steady_window_from_m": lo, "steady_window_to_m": hi, "steady_cycles": len(cyc)}
+    for key, name in zip(SERIES, ("Fc_N", "Ft_N", "chip_m")):
+        v = np.array([r[key] for r in rows], dtype=float)
+        ok = inc & np.isfinite(v)
+        c = np.array([r[key] for r in cyc], dtype=float)
+        c = c[np.isfinite(c)]
+        out[f"steady_{name}"] = float(np.average(v[ok], weights=w[ok])) if ok.any() else float("nan")
+        out[f"steady_{name}_spread"] = float(np.ptp(c) / abs(c.mean())) if len(c) > 1 else float("nan")
+        out[f"steady_{name}_trend"] = (_trend([r for r in cyc if np.isfinite(r[key])], key, length)
+                                       if len(c) > 1 else float("nan"))
+    return out
+
+
 def _trend(rows: list[dict], key: str, length: float) -> float:
     """The change over ``length`` of travel of a least-squares line through the window, over its mean: the part
     of a spread that is a drift (a cut still settling) rather than a scatter.

@@ -1,8 +1,7 @@
 """The quasi-static loop: build the mesh, step the load, cut steps that fail, write results, report.
 
-:func:`run` is the table of contents; each step is a small function below it. Step control is in
-:mod:`.steps`, the FreeFEM command of a scene in :mod:`.launch`, the checkpoint in :mod:`.checkpoint`,
-the progress lines in :mod:`.progress`, the remesh step in :mod:`wendel.remesh.step`.
+:func:`run` is the table of contents; each step is a small function below it. Step control: :mod:`.steps`, FreeFEM
+command: :mod:`.launch`, checkpoint: :mod:`.checkpoint`, progress: :mod:`.progress`, remesh: :mod:`wendel.remesh.step`.
 """
 
 from __future__ import annotations
@@ -16,6 +15,7 @@ import time
 from pathlib import Path
 
 from .. import freefem
+from ..cutting.fe_run import report_resumed
 from ..errors import DiskFull, RunFolderError
 from ..meshes import build as build_mesh
 from ..remesh import batch as remesh_batch
@@ -52,7 +52,7 @@ def run(scene_path: str | Path, smoke: bool = False, ranks: int | None = None, o
         with guarded(root):
             files, scene, state = resume_run(root, progress)
             progress(f"resuming {files.root} after increment {state.last[0]} (load factor {state.last[1]:g})")
-            return _execute(scene, files, state, progress)
+            return report_resumed(_execute(scene, files, state, progress), progress)     # a cut: its cutting report
     scene_path = Path(scene_path)
     scene = load(scene_path, smoke=smoke)
     if getattr(scene, "cutting", None) is not None:     # an orthogonal cut: the FE scene it derives (issue 17)

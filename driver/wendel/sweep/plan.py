@@ -14,8 +14,8 @@ A sweep file names a scene and a plan over its dotted keys::
     seed = 1
     ranges = {"material.nu" = [0.2, 0.3]}   # 1
 
-The blocks present are combined as a product (grid points x zip rows x samples). Every planned scene is
-validated before anything runs; a bad combination refuses the sweep naming the key and the values.
+The blocks present are combined as a product (grid points x zip rows x samples); ``[set]`` (key = value) is
+applied to every run. Every planned scene is validated first; a bad one refuses the sweep naming key and values.
 
 >>> points = grid_points({"a": [1, 2], "b": [3, 4]})
 >>> [tuple(p.values()) for p in points]
@@ -102,6 +102,7 @@ class SweepFile(BaseModel):
     smoke: bool = Field(False, description="start from the scene's [smoke] size")
     grid: dict = Field(default_factory=dict, description="dotted key = [values]: every combination")
     zip: dict = Field(default_factory=dict, description="dotted key = [values]: lists advanced together")
+    set: dict = Field(default_factory=dict, description="dotted key = value: set in every run, not swept")
     sample: Optional[Sample] = None
     outputs: list[str] = Field(default_factory=lambda: ["wall_time"],
                                description="summary.json keys (or last_increment keys) plotted against each parameter")
@@ -225,9 +226,8 @@ def folder_name(params: dict, digest: str) -> str:
 def load_sweep(path: str | Path) -> Sweep:
     """Read the sweep file, plan every run and validate every planned scene (SceneError names key and values)."""
     path = Path(path)
-    raw = read_toml(path, "sweep")
     try:
-        spec = SweepFile.model_validate(raw)
+        spec = SweepFile.model_validate(read_toml(path, "sweep"))
     except ValidationError as exc:
         raise SceneError("\n".join(f"{path}: {'.'.join(map(str, e['loc']))}: {e['msg']}" for e in exc.errors())) from None
     scene_path = (path.parent / spec.scene).resolve()
@@ -238,6 +238,11 @@ def load_sweep(path: str | Path) -> Sweep:
     if spec.smoke:
         for k, v in (base.get("smoke") or {}).items():
             set_key(base, SMOKE_KEYS[k], v)
+    for k, v in (fixed := flatten(spec.set)).items():        # [set]: the same in every run, not a parameter
+        try:
+            set_key(base, k, v)
+        except KeyError:
+            raise SceneError(f"{path}: set.{k}: not a table of the scene") from None
     if isinstance(base.get("geometry", {}).get("mesh"), str):  # a mesh file stays found from anywhere
         base["geometry"]["mesh"] = str((scene_path.parent / base["geometry"]["mesh"]).resolve())
 
@@ -261,7 +266,7 @@ def load_sweep(path: str | Path) -> Sweep:
             if not (isinstance(v, list) and len(v) == 2 and all(isinstance(x, (int, float)) for x in v) and v[0] < v[1]):
                 raise SceneError(f"{path}: sample.ranges.{k}: give [low, high] with low < high")
         blocks.append(sample_points(spec.sample.method, spec.sample.count, spec.sample.seed, ranges))
-    seen: dict[str, str] = {}
+    seen: dict[str, str] = {k: "set" for k in fixed}
     for name, table in (("grid", grid), ("zip", zipped), ("sample", flatten(spec.sample.ranges) if spec.sample else {})):
         for k in table:
             if k in seen:

@@ -1,0 +1,34 @@
+"""``wendel bench cutting-kienzle``: Kienzle's k_c1.1 and m_c of AISI 1045 from FE cuts (issue 17).
+
+Runs the campaign ``workflows/campaigns/cutting-kienzle.toml`` with ``wendel sweep`` (local; its folder
+results/sweeps/cutting-kienzle/, so a sweep run or interrupted before is resumed, not repeated, and a failed cut tried
+again: about 40 core minutes from scratch) and fits F_c = b k_c1.1 h^(1 - m_c) to each cut's steady F_c (the mean over its last h of
+travel) per (speed, rake), beside the Oxley model's fit at the same conditions and the catalogue constants
+(:mod:`wendel.cutting.fe_campaign`). Rows: one per cut (``kind = "cut"``: F_c FE and Oxley, the window, the
+spread and drift of the remesh-cycle means in it) and one per fit (``kind = "fit"``); the picture
+results/bench/cutting-kienzle.png (F_c against h, log-log). ``--quick`` reads the sweep folder as it stands
+(the cuts done so far) without running anything.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from . import WORKFLOWS, register
+
+SWEEP = WORKFLOWS / "campaigns" / "cutting-kienzle.toml"
+
+
+@register("cutting-kienzle")
+def cutting_kienzle(quick: bool, workdir: Path) -> list[dict]:
+    from ..cutting import fe_campaign
+    from ..sweep import run_sweep, sweep_root
+
+    if not quick:
+        run_sweep(SWEEP, quiet=True, log=lambda *_: None)
+    root = sweep_root(SWEEP)
+    cuts = fe_campaign.points(root)
+    fits = fe_campaign.compare(cuts, "aisi1045")
+    fe_campaign.plot(workdir.parents[1] / "cutting-kienzle.png", cuts, fits,
+                     "AISI 1045: FE cuts (edge r/2, last h of 2.67 h) against Oxley, catalogues")
+    return [{"kind": "cut", **r} for r in cuts] + [{"kind": "fit", **f} for f in fits]
