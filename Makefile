@@ -13,7 +13,7 @@ SCENE ?= workflows/drilling-rz.toml   # the product's main job: a small drilling
 
 .PHONY: setup run test bench dealii clean
 setup: build/.apt-ok $(VENV)/.ok build/plugins/MUMPS_mpi.so build/plugins/wendel_petsc.so build/plugins/wendel_tool.so \
-       build/plugins/wendel_kernels.so
+       build/plugins/wendel_kernels.so build/plugins/wendel_io.so
 	@# wendel's own bytecode, where PYTHONDONTWRITEBYTECODE=1 would compile it at every start (issue 20)
 	@$(VENV)/bin/python -m compileall -q driver/wendel meshes > /dev/null
 
@@ -52,6 +52,11 @@ build/plugins/wendel_kernels.so: edp/plugins/wendel_kernels.cpp build/.apt-ok
 build/plugins/wendel_tool.so: edp/plugins/wendel_tool.cpp build/.apt-ok
 	@mkdir -p build/plugins
 	g++ -shared -fPIC -O2 -Wall -Wno-unused-variable -Wno-sign-compare -Wno-mismatched-new-delete -isystem /usr/include/freefem++ $< -o $@
+
+# wendel's file writer (lib/common.idp, lib/io.idp): an increment's files written by a thread (issue 20).
+build/plugins/wendel_io.so: edp/plugins/wendel_io.cpp build/.apt-ok
+	@mkdir -p build/plugins
+	g++ -shared -fPIC -O2 -Wall -Wno-unused-variable -Wno-sign-compare -Wno-mismatched-new-delete -isystem /usr/include/freefem++ $< -o $@ -pthread
 
 run: setup
 	$(VENV)/bin/wendel run $(SCENE)

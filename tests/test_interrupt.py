@@ -125,9 +125,10 @@ def test_kill9_resumes_to_the_same_result(event, tmp_path, reference):
 def test_interrupt_stops_freefem_and_resumes(sig, tmp_path, reference):
     run = tmp_path / "run"
     p = _start(str(SCENE), "--smoke", "--out", str(run))
-    while p.poll() is None and not _freefem_of(run):
-        time.sleep(0.01)
-    time.sleep(0.3)
+    # mid-run: once FreeFEM has committed the first increment (a fixed 0.3 s after the first FreeFEM was seen
+    # raced with the short launches: the run had sometimes ended before the signal)
+    while p.poll() is None and not (run / "fem" / "inc-0001" / "done").is_file():
+        time.sleep(0.005)
     p.send_signal(sig)
     out, err = p.communicate(timeout=60)
     assert p.returncode == 130, (p.returncode, err)

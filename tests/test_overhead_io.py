@@ -1,0 +1,55 @@
+"""FreeFEM's increment files written by a thread (edp/plugins/wendel_io.cpp, issue 20): the bytes of
+BinaryIO's SaveVec, the values as they were when queued, every file written before a marker queued after it
+and before the process ends (also by exit(n)), and a file that cannot be written stops the process with
+exit code 3 before any later file."""
+
+from __future__ import annotations
+
+import subprocess
+
+from wendel import freefem
+from wendel.results import vtu
+
+
+def _freefem(tmp_path, body: str) -> subprocess.CompletedProcess:
+    script = tmp_path / "io.edp"
+    script.write_text('load "BinaryIO"\nload "wendel_io"\n' + body)
+    env = dict(freefem.environment(), OMPI_MCA_ess_singleton_isolated="1")
+    return subprocess.run(["FreeFem++-mpi", "-nw", "-v", "0", str(script)], cwd=tmp_path, env=env,
+                          capture_output=True, text=True, timeout=60)
+
+
+def test_queued_files_are_savevec_bytes_written_in_order_before_exit(tmp_path):
+    r = _freefem(tmp_path, """
+real[int] a(5000);
+for (int i = 0; i < 5000; ++i) a[i] = sin(1.37 * i) * (i + 1) * 1e-3;
+SaveVec(a, "savevec.bin");
+wendelSave(a, "queued.bin");
+a = -1;                                  // the queued copy keeps the values of the call
+for (int k = 0; k < 200; ++k) wendelSave(a, "f" + k + ".bin");
+wendelWrite("done", "ok\\n");
+exit(4);                                 // as a failed Newton step: the queue is still written out
+""")
+    assert r.returncode == 4, r.stdout + r.stderr
+    assert (tmp_path / "queued.bin").read_bytes() == (tmp_path / "savevec.bin").read_bytes()
+    assert vtu.read_array(tmp_path / "f199.bin").tolist() == [-1.0] * 5000
+    assert (tmp_path / "done").read_text() == "ok\n"
+    done = (tmp_path / "done").stat().st_mtime_ns
+    assert all((tmp_path / f"f{k}.bin").stat().st_mtime_ns <= done for k in range(200))
+
+
+def test_a_file_that_cannot_be_written_stops_before_any_later_file(tmp_path):
+    r = _freefem(tmp_path, """
+real[int] a(10); a = 1;
+wendelSave(a, "first.bin");
+wendelSave(a, "no-such-folder/second.bin");
+wendelSave(a, "third.bin");
+wendelWrite("done", "ok\\n");
+wendelFlush();
+cout << "not reached" << endl;
+""")
+    assert r.returncode == 3, r.stdout + r.stderr
+    assert "cannot write" in r.stderr and "no-such-folder/second.bin" in r.stderr
+    assert (tmp_path / "first.bin").is_file()
+    assert not (tmp_path / "third.bin").exists() and not (tmp_path / "done").exists()
+    assert "not reached" not in r.stdout
