@@ -66,6 +66,22 @@ def test_3d_tangent_matches_the_residual_differences_at_a_deformed_plastic_state
         assert [r["residual"] for r in rows(out / inc / "newton.csv")] == plain
 
 
+@pytest.mark.parametrize("name", ["ul-compression", "ul-compression-axi"])
+def test_2d_tangent_is_the_residual_derivative_in_every_direction(tmp_path, quiet, name):
+    # Plane strain and (r, z) compression with hardening, 2-10 % an increment: the tangent carries the exact
+    # derivative of the strain update (the polar angle and ln V of the increment, kinematics.idp's ulExact), so
+    # it equals the residual's central differences along the Newton step and in a random direction (measured
+    # 2e-9 and 5e-10 at most; with the Jaumann spin and sym grad standing for them the random direction
+    # differed by up to 1.4e-3 on the plane-strain block)
+    root = run(WORKFLOWS / f"{name}.toml", smoke=True, out=tmp_path / "run", progress=quiet, png=False)
+    out = relaunch(root, tmp_path / "fd", "-newton_fd_check", "1e-6")
+    fd = rows(out / "fdcheck.csv")
+    newton = [float(r["relative_difference"]) for r in fd if r["direction"] == "newton"]
+    random = [float(r["relative_difference"]) for r in fd if r["direction"] == "random" and r["iteration"] != "0"]
+    assert len(newton) >= 10 and len(random) == len(newton)
+    assert max(newton) < 1e-7 and max(random) < 1e-7
+
+
 def test_extrapolated_predictor_saves_a_newton_iteration_per_increment(scene_file, tmp_path, quiet):
     # 5 increments of 1 %: from the accepted state each plastic increment takes 3 Newton iterations (relative
     # residuals 0.016, 3e-7, 1e-14: quadratic, the first step's error is the path's curvature); from the
