@@ -19,7 +19,9 @@ from conftest import WORKFLOWS, smoke_ball
 def ball(out, assembly: str, solver: str = "cg", ranks: int = 1) -> tuple[dict, np.ndarray]:
     root = smoke_ball(out, solver=solver, ranks=ranks, assembly=assembly)
     u = read_array(sorted(root.glob("fem/inc-*/u.node.txt"))[-1])
-    return json.loads((root / "summary.json").read_text()), u
+    summary = json.loads((root / "summary.json").read_text())
+    summary["root"] = root
+    return summary, u
 
 
 @pytest.fixture(scope="module")
@@ -36,9 +38,14 @@ def test_compiled_kernels_reproduce_the_varf_assembly(tmp_path, ball_freefem):
     assert lc["linear_iterations"] == lf["linear_iterations"]
     assert lc["contact_active_nodes"] == lf["contact_active_nodes"]
     assert lc["plastic_points"] == lf["plastic_points"]
-    for key in ("contact_force", "max_von_mises", "plastic_volume", "max_plastic_strain"):
+    for key in ("contact_force", "max_von_mises", "plastic_volume", "max_plastic_strain", "strain_energy"):
         assert lc[key] == pytest.approx(lf[key], rel=1e-10), key
     assert np.abs(uc - uf).max() <= 1e-10 * np.abs(uf).max()
+    # the cell fields the kernels take from the quadrature state, not from P0 interpolations (kernelCellStress)
+    for name in ("vonMises", "strain_xx", "strain_zz", "strain_yz", "strain_xy"):
+        a, b = (read_array(sorted((r / "fem").glob("inc-*"))[-1] / f"{name}.cell.txt")
+                for r in (f["root"], c["root"]))
+        assert a.shape == b.shape and np.abs(b - a).max() <= 1e-9 * np.abs(a).max(), name
     # the point of the kernels: the assembly of the Newton step is cheaper than FreeFEM's forms
     assert lc["time_tangent"] < lf["time_tangent"]
 

@@ -30,9 +30,10 @@ def _row(out: Path, h: float, ranks: int) -> dict:
     s = json.loads((out / "summary.json").read_text())
     row = {k: r[k] for k in ("ranks", "dofs", "newton_iterations", "krylov_per_step", "contact_force", "wall_time",
                              "cpu_time", "assembly_s_per_step", "constitutive_s_per_step", "solve_s_per_step",
-                             "petsc_setup_s_per_step", "petsc_krylov_s_per_step")}
+                             "petsc_setup_s_per_step", "petsc_krylov_s_per_step", "tangent_s_per_step")}
     row["step_s"] = r["assembly_s_per_step"] + r["constitutive_s_per_step"] + r["solve_s_per_step"]
     row["local_tets"] = s["last_increment"].get("petsc_local_tets", 0)
+    row["active_set_s"] = s["last_increment"].get("time_active_set", 0.0)     # contact rows (part of assembly)
     row["elements"] = s["elements"]
     for p in PHASES:
         row[f"{p}_s"] = s["wall_time_by_phase"].get(p, 0.0)
