@@ -99,3 +99,41 @@ def test_a_launch_started_ahead_with_other_options_is_stopped_and_the_asked_one_
     finally:
         prestart.abandon(wrong)
         prestart.abandon(right)
+
+
+def test_a_launch_started_early_waits_at_nice_19_and_runs_at_the_drivers_priority(tmp_path):
+    """prestart.start(..., early=True) (the drilling loop: the next launch beside this one's solve): until
+    "go" every thread of FreeFEM runs at nice 19; from "go" at the driver's priority (a command FreeFEM runs
+    inherits it), and the launch gives the same file as one started late."""
+    import os
+
+    import pytest
+
+    from wendel import freefem, prestart
+
+    if not prestart.can_start_early():
+        pytest.skip("this process may not raise a priority again (not root, no RLIMIT_NICE)")
+    script = tmp_path / "gate.edp"
+    script.write_text('include "lib/common.idp"\n'
+                      'string word; { ifstream f(getARGV("-in", "")); f >> word; }\n'
+                      'exec("ps -o ni= -p $PPID > " + outDir + "/nice.txt");\n'
+                      '{ ofstream f(outDir + "/said.txt"); f << word << endl; }\n')
+    out, inp = tmp_path / "out", tmp_path / "in.txt"
+    early = prestart.start(str(script), ["-in", str(inp)], out, early=True)
+    try:
+        assert early is not None and early.nice == os.getpriority(os.PRIO_PROCESS, 0)
+        import time
+        deadline = time.monotonic() + 20
+        while time.monotonic() < deadline:      # nice execs setpriv, which execs FreeFEM: the same pid
+            if "FreeFem" in (open(f"/proc/{early.proc.pid}/cmdline").read()):
+                break
+            time.sleep(0.01)
+        for tid in os.listdir(f"/proc/{early.proc.pid}/task"):
+            assert os.getpriority(os.PRIO_PROCESS, int(tid)) == prestart.EARLY_NICE
+        inp.write_text("early\n")
+        launch = freefem.run(str(script), ["-in", str(inp)], out, started=early)
+        assert launch.command[:3] == ["nice", "-n", str(prestart.EARLY_NICE - early.nice)]
+        assert (out / "said.txt").read_text().split() == ["early"]
+        assert int((out / "nice.txt").read_text()) == early.nice
+    finally:
+        prestart.abandon(early)

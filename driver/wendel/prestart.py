@@ -9,6 +9,12 @@ compiles and then waits at its gate (``-DWITHGATE=1``, ``edp/lib/common.idp``) b
 times the launch from there. A launch whose command line turned out otherwise is stopped unused
 (:func:`abandon`) and started as usual: the launch FreeFEM runs is always the one asked for.
 ``WENDEL_PRESTART=0``: no launch is started ahead (every launch starts when asked, as before).
+
+``start(..., early=True)``: the launch is started beside the solve of the launch before it (the drilling loop:
+at the start of each removal step's launch), at the lowest CPU priority (nice 19), so that its start (0.15-0.3
+s of CPU: the process, MPI, the plugins, compiling) takes only CPU the solve leaves unused; ``run`` gives it
+the driver's priority back (every thread) when it says "go". Without the right to raise a priority again
+(not root and no ``RLIMIT_NICE`` for it) ``early`` is not honoured (None: the caller starts it later).
 """
 
 from __future__ import annotations
@@ -33,21 +39,47 @@ class Started:
     cmd: list[str]
     session: str
     log: Path
+    nice: int | None = None     # the priority to give it back at "go" (started early at nice 19), or None
 
 
-def start(entry: str, options: list[str], out_dir: Path, ranks: int = 1, log: Path | None = None) -> Started | None:
+EARLY_NICE = 19
+"""The priority of a launch started early, beside a solve (``start(..., early=True)``)."""
+
+
+def can_start_early() -> bool:
+    """Whether a launch started at nice 19 can be given this process's priority back (:func:`start`'s
+    ``early``): root, or an ``RLIMIT_NICE`` that allows it; ``WENDEL_PRESTART`` not ``0`` or ``late``."""
+    if os.environ.get("WENDEL_PRESTART", "1") in ("0", "late"):
+        return False
+    if os.geteuid() == 0:
+        return True
+    try:
+        import resource
+        soft = resource.getrlimit(resource.RLIMIT_NICE)[0]
+    except (ImportError, AttributeError, OSError, ValueError):
+        return False
+    return soft == resource.RLIM_INFINITY or 20 - soft <= os.getpriority(os.PRIO_PROCESS, 0)
+
+
+def start(entry: str, options: list[str], out_dir: Path, ranks: int = 1, log: Path | None = None,
+          early: bool = False) -> Started | None:
     """Start the launch :func:`wendel.freefem.run` will be asked for with these arguments, before its input
     files exist; FreeFEM waits until ``run`` says "go" on its stdin, :func:`abandon` stops it unused. One rank
-    only (None otherwise: stdin reaches one rank of ``mpirun``)."""
-    if os.environ.get("WENDEL_PRESTART", "1") == "0":
+    only (None otherwise: stdin reaches one rank of ``mpirun``). ``early``: beside a solve, at nice 19 until
+    "go" (None when :func:`can_start_early` says no)."""
+    if os.environ.get("WENDEL_PRESTART", "1") == "0" or (early and not can_start_early()):
         return None
     script, cmd, env, session, singleton = _command(entry, options, out_dir, ranks, gate=True)
     if not singleton:
         shutil.rmtree(session, ignore_errors=True)
         return None
+    nice = None
+    if early:
+        nice = os.getpriority(os.PRIO_PROCESS, 0)
+        cmd = ["nice", "-n", str(max(EARLY_NICE - nice, 0)), *cmd]
     log = log or out_dir / "freefem.log"
     proc = _popen(cmd, env, out_dir, log, subprocess.PIPE)
-    return Started(entry, list(options), out_dir, proc, cmd, session, log)
+    return Started(entry, list(options), out_dir, proc, cmd, session, log, nice)
 
 
 def abandon(started: Started | None) -> None:

@@ -333,12 +333,16 @@ class Process:
             overlap.preload("matplotlib", "matplotlib.pyplot")
         before, t0 = len(state.accepted), time.perf_counter()
         try:
+            # the next launch starts beside this solve at nice 19 (its start takes only the CPU the solve leaves;
+            # at nice 0 it slowed the solve on this shared machine: drilling-3d 10.8 -> 12.0 s), and is given the
+            # driver's priority at its "go"; where the priority cannot be raised again, it starts after this
+            # launch, while the driver accepts, removes and transfers (wendel.prestart)
+            self.ahead = self.start_next(inc0 + len(lfs), seg, scene_opts, early=True)
             freefem.run(self.entry, opts, files.fem, ranks=work.numerics.ranks, timeout=work.numerics.timeout,
                         log=files.root / "freefem.log", started=ahead)
             wall = time.perf_counter() - t0      # FreeFEM's end: the accept below is driver output (no double count)
-            # the next launch starts while the driver accepts, removes and transfers; not beside this solve:
-            # there it slowed the solve on this shared machine (drilling-3d 10.8 -> 12.0 s, one run each)
-            self.ahead = self.start_next(inc0 + len(lfs), seg, scene_opts)
+            if self.ahead is None:
+                self.ahead = self.start_next(inc0 + len(lfs), seg, scene_opts)
         finally:
             accept(work, files, state, self.dim)
             state.launches.append({"wall": wall if wall is not None else time.perf_counter() - t0,
@@ -356,12 +360,12 @@ class Process:
             ["-loads", str(files.tables / "loads.txt"), "-inc0", str(inc0)]
         return opts + (["-restart", str(files.root / restart)] if restart else [])
 
-    def start_next(self, inc: int, seg: dict, scene_opts: list[str]):
+    def start_next(self, inc: int, seg: dict, scene_opts: list[str], early: bool = False):
         """Start the launch of increment ``inc`` (the next removal step or the cooling) while the driver accepts
         this one, removes and transfers (:mod:`wendel.prestart`), with the options :meth:`removal_step` or
         :meth:`cool` will ask for if nothing but the mesh, the restart and ``-inc0`` change (``scene_opts``:
         this launch's :func:`wendel.loop.launch.options`, not computed again: that writes tables); else None.
-        A launch asked otherwise is not taken."""
+        A launch asked otherwise is not taken. ``early``: beside this launch's solve (:func:`wendel.prestart.start`)."""
         k = inc - 1                                     # the step (or cooling) just launched: increment k
         if k < len(self.steps):                         # the next removal step
             step, now = self.steps[k], self.steps[k - 1] if k >= 1 else None
@@ -378,7 +382,7 @@ class Process:
         opts = list(scene_opts)
         opts[opts.index("-mesh") + 1] = str(self.files.root / nxt["mesh"])
         return prestart.start(self.entry, self.command(inc, nxt, restart, opts), self.files.fem,
-                              ranks=self.work.numerics.ranks, log=self.files.root / "freefem.log")
+                              ranks=self.work.numerics.ranks, log=self.files.root / "freefem.log", early=early)
 
     # ---- bookkeeping after a launch
     def close_rows(self, rows: list[dict]) -> None:
