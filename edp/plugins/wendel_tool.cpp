@@ -15,6 +15,19 @@
 //   n     output (3 numbers): the gradient of the signed distance, pointing out of the tool
 //   returns the signed distance: > 0 outside the tool, < 0 inside.
 //
+//   long nnz = wendelFricFrame(matrix A, matrix K, long nd, int[int] dof0, real[int] fE, real[int] Pb,
+//                              real[int] Hb, real[int] fr);
+//       The Newton matrix of lib/friction.idp in the contact nodes' local frames, in one pass over K:
+//         A = (Dfree (P Q' K Q + H) Dfree + Dfix) Q'
+//       with Q the rotation to the nodes' frames, P the slip rows and H their slip term, Dfree/Dfix the
+//       diagonal masks of the free rows and those of fixed value. Q, P, H differ from the identity (zero for H)
+//       only in the nd x nd blocks of the contact nodes, so A = L K R + B with the blocks
+//         L = Dfree P Q', R = Q Dfree Q', B = (Dfree H Dfree + Dfix) Q'
+//       and the identity (zero) elsewhere. Per contact node j: dof0[j] its first DoF (DoFs dof0 .. dof0 + nd - 1),
+//       fE[9 j + 3 a + k] component k of frame vector a (Q[dof0 + k, dof0 + a]), Pb and Hb its P and H blocks
+//       (nd x nd, row-major at nd nd j), fr[nd j + a] 1 for a free local row a, 0 for a fixed one. A may be K.
+//       Returns nnz(A); A's pattern is K's with the contact nodes' rows and columns filled to whole blocks.
+//
 // The closest point on each triangle by its Voronoi regions (face, edge or vertex: Ericson, Real-Time
 // Collision Detection, 2005, sec. 5.1.5); the sign from the pseudo-normal of the feature holding the nearest
 // point (Baerentzen and Aanaes, IEEE TVCG 11, 2005: angle-weighted pseudo-normals give the right sign for
@@ -23,7 +36,9 @@
 #include "ff++.hpp"
 #include "AFunction_ext.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 namespace {
 
@@ -96,11 +111,100 @@ double wendelTriDistance(KN<double>* const& tris, KN<double>* const& y, KN<doubl
     return sgn * dist;
 }
 
+
+// The frame change of lib/friction.idp's Newton matrix (see the head of the file): A = L K R + B.
+long wendelFricFrame(Matrice_Creuse<double>* const& A, Matrice_Creuse<double>* const& K, const long& nd,
+                     KN<long>* const& dof0, KN<double>* const& fE, KN<double>* const& Pb, KN<double>* const& Hb,
+                     KN<double>* const& fr)
+{
+    HashMatrix<int, double>* HK = K->pHM();
+    if (!HK) ExecError("wendelFricFrame: K is not a sparse matrix");
+    if (HK->half) ExecError("wendelFricFrame: K must be stored whole (not symmetric half)");
+    if (nd < 2 || nd > 3) ExecError("wendelFricFrame: nd must be 2 or 3");
+    const long n = HK->n, nc = dof0->N(), b2 = nd * nd;
+    if (HK->m != n) ExecError("wendelFricFrame: K must be square");
+    if (fE->N() < 9 * nc || Pb->N() < b2 * nc || Hb->N() < b2 * nc || fr->N() < nd * nc)
+        ExecError("wendelFricFrame: fE needs 9, Pb and Hb nd^2, fr nd numbers per contact node");
+    std::vector<int> blk(n, -1);
+    std::vector<double> L(b2 * nc), R(b2 * nc), B(b2 * nc);
+    for (long j = 0; j < nc; ++j) {
+        const long p0 = (*dof0)[j];
+        if (p0 < 0 || p0 + nd > n) ExecError("wendelFricFrame: a contact DoF is out of range");
+        for (int a = 0; a < nd; ++a) {
+            if (blk[p0 + a] >= 0) ExecError("wendelFricFrame: a contact node is listed twice");
+            blk[p0 + a] = (int)j;
+        }
+        double Qt[3][3], f[3];                    // Qt[a][k] = frame vector a, component k
+        for (int a = 0; a < nd; ++a) {
+            f[a] = (*fr)[nd * j + a];
+            for (int k = 0; k < nd; ++k) Qt[a][k] = (*fE)[9 * j + 3 * a + k];
+        }
+        const double* P = &(*Pb)[b2 * j];
+        const double* H = &(*Hb)[b2 * j];
+        for (int a = 0; a < nd; ++a)
+            for (int k = 0; k < nd; ++k) {
+                double l = 0, r = 0, b = 0;
+                for (int c = 0; c < nd; ++c) {
+                    l += P[nd * a + c] * Qt[c][k];
+                    r += Qt[c][a] * f[c] * Qt[c][k];
+                    b += H[nd * a + c] * f[c] * Qt[c][k];
+                }
+                L[b2 * j + nd * a + k] = f[a] * l;
+                R[b2 * j + nd * a + k] = r;
+                B[b2 * j + nd * a + k] = f[a] * b + (1.0 - f[a]) * Qt[a][k];
+            }
+    }
+    HK->CSR();                                    // sorted by rows, row pointers p
+    const int *kp = HK->p, *kj = HK->j;
+    const double* ka = HK->aij;
+    std::vector<int> rowptr(n + 1, 0), cols, mark(n, -1), touched;
+    std::vector<double> vals, w(n, 0.0);
+    cols.reserve(HK->nnz + 4 * b2 * nc);
+    vals.reserve(HK->nnz + 4 * b2 * nc);
+    touched.reserve(256);
+    auto add = [&](int c, double v, int i) {
+        if (mark[c] != i) { mark[c] = i; w[c] = 0.0; touched.push_back(c); }
+        w[c] += v;
+    };
+    for (long i = 0; i < n; ++i) {
+        touched.clear();
+        const int j = blk[i];
+        const long p0 = j >= 0 ? (*dof0)[j] : i;
+        const int a = (int)(i - p0), ns = j >= 0 ? (int)nd : 1;
+        for (int s = 0; s < ns; ++s) {
+            const double coef = j >= 0 ? L[b2 * j + nd * a + s] : 1.0;
+            const long r = p0 + s;
+            for (int q = kp[r]; q < kp[r + 1]; ++q) {
+                const int c = kj[q], jc = blk[c];
+                const double v = coef * ka[q];
+                if (jc < 0) { add(c, v, (int)i); continue; }
+                const long q0 = (*dof0)[jc];
+                const double* Rr = &R[b2 * jc + nd * (c - q0)];
+                for (int e = 0; e < nd; ++e) add((int)(q0 + e), v * Rr[e], (int)i);
+            }
+        }
+        if (j >= 0)
+            for (int e = 0; e < nd; ++e) add((int)(p0 + e), B[b2 * j + nd * a + e], (int)i);
+        std::sort(touched.begin(), touched.end());
+        for (int c : touched) { cols.push_back(c); vals.push_back(w[c]); }
+        rowptr[i + 1] = (int)cols.size();
+    }
+    A->resize(n, n);
+    HashMatrix<int, double>* HA = A->pHM();
+    if (!HA) ExecError("wendelFricFrame: A is not a sparse matrix");
+    if (A->pMC()) A->pMC()->SetSolver();
+    HA->set((int)n, (int)n, 0, vals.size(), rowptr.data(), cols.data(), vals.data(), 0, 1);
+    return (long)vals.size();
+}
+
 }  // namespace
 
 static void Load_Init()
 {
     Global.Add("wendelTriDistance", "(",
                new OneOperator3_<double, KN<double>*, KN<double>*, KN<double>*>(wendelTriDistance));
+    Global.Add("wendelFricFrame", "(",
+               new OneOperator8_<long, Matrice_Creuse<double>*, Matrice_Creuse<double>*, long, KN<long>*,
+                                 KN<double>*, KN<double>*, KN<double>*, KN<double>*>(wendelFricFrame));
 }
 LOADFUNC(Load_Init)
