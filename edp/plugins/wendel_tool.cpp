@@ -28,6 +28,14 @@
 //       (nd x nd, row-major at nd nd j), fr[nd j + a] 1 for a free local row a, 0 for a fixed one. A may be K.
 //       Returns nnz(A); A's pattern is K's with the contact nodes' rows and columns filled to whole blocks.
 //
+//   long wendelFricQt(long nd, int[int] dof0, real[int] fE, real[int] x, real[int] y);
+//   long wendelFricKl(matrix K, long nd, int[int] dof0, real[int] fE, real[int] Pb, real[int] Hb, real[int] x,
+//                     real[int] y);
+//       The vectors of the same frame change (the same blocks as wendelFricFrame), y resized to x's size
+//       (y may be x): y = Q' x, and y = (P Q' K Q + H) x.
+//   long wendelFricRowsPQ(matrix M, long n, long nd, int[int] dof0, real[int] fE, real[int] Pb);
+//       M = P Q' (n x n: the identity with the contact nodes' blocks P_j Q_j').
+//
 // The closest point on each triangle by its Voronoi regions (face, edge or vertex: Ericson, Real-Time
 // Collision Detection, 2005, sec. 5.1.5); the sign from the pseudo-normal of the feature holding the nearest
 // point (Baerentzen and Aanaes, IEEE TVCG 11, 2005: angle-weighted pseudo-normals give the right sign for
@@ -38,6 +46,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 #include <vector>
 
 namespace {
@@ -197,6 +206,120 @@ long wendelFricFrame(Matrice_Creuse<double>* const& A, Matrice_Creuse<double>* c
     return (long)vals.size();
 }
 
+// Shared checks of the contact blocks' arrays (wendelFricVec, wendelFricRowsPQ).
+void fricCheck(const char* who, long n, long nd, KN<long>* dof0, KN<double>* fE, KN<double>* Pb)
+{
+    if (nd < 2 || nd > 3) ExecError(std::string(who) + ": nd must be 2 or 3");
+    const long nc = dof0->N();
+    if (fE->N() < 9 * nc || Pb->N() < nd * nd * nc) ExecError(std::string(who) + ": fE needs 9, Pb nd^2 numbers per contact node");
+    for (long j = 0; j < nc; ++j)
+        if ((*dof0)[j] < 0 || (*dof0)[j] + nd > n) ExecError(std::string(who) + ": a contact DoF is out of range");
+}
+
+long fricVec(Matrice_Creuse<double>* K, long mode, long nd, KN<long>* dof0, KN<double>* fE, KN<double>* Pb,
+             KN<double>* Hb, KN<double>* x, KN<double>* y)
+{
+    const long n = x->N(), nc = dof0->N(), b2 = nd * nd;
+    fricCheck("wendelFricVec", n, nd, dof0, fE, mode == 1 ? Pb : fE);
+    if (mode == 1 && Hb->N() < b2 * nc) ExecError("wendelFricVec: Hb needs nd^2 numbers per contact node");
+    std::vector<double> xv(n), z(n);
+    for (long i = 0; i < n; ++i) xv[i] = (*x)[i];
+    if (mode == 0) {
+        z = xv;
+        for (long j = 0; j < nc; ++j) {
+            const long p0 = (*dof0)[j];
+            for (int a = 0; a < nd; ++a) {
+                double w = 0;
+                for (int k = 0; k < nd; ++k) w += (*fE)[9 * j + 3 * a + k] * xv[p0 + k];
+                z[p0 + a] = w;
+            }
+        }
+    } else if (mode == 1) {
+        HashMatrix<int, double>* HK = K->pHM();
+        if (!HK) ExecError("wendelFricVec: K is not a sparse matrix");
+        if (HK->half || HK->n != n || HK->m != n) ExecError("wendelFricVec: K must be whole and n x n with n = x's size");
+        std::vector<double> q = xv;                       // Q x
+        for (long j = 0; j < nc; ++j) {
+            const long p0 = (*dof0)[j];
+            for (int k = 0; k < nd; ++k) {
+                double w = 0;
+                for (int a = 0; a < nd; ++a) w += (*fE)[9 * j + 3 * a + k] * xv[p0 + a];
+                q[p0 + k] = w;
+            }
+        }
+        HK->CSR();
+        const int *kp = HK->p, *kj = HK->j;
+        const double* ka = HK->aij;
+        for (long i = 0; i < n; ++i) {
+            double s = 0;
+            for (int t = kp[i]; t < kp[i + 1]; ++t) s += ka[t] * q[kj[t]];
+            z[i] = s;
+        }
+        for (long j = 0; j < nc; ++j) {
+            const long p0 = (*dof0)[j];
+            double w[3], r[3];
+            for (int c = 0; c < nd; ++c) {
+                w[c] = 0;
+                for (int k = 0; k < nd; ++k) w[c] += (*fE)[9 * j + 3 * c + k] * z[p0 + k];
+            }
+            for (int a = 0; a < nd; ++a) {
+                r[a] = 0;
+                for (int c = 0; c < nd; ++c)
+                    r[a] += (*Pb)[b2 * j + nd * a + c] * w[c] + (*Hb)[b2 * j + nd * a + c] * xv[p0 + c];
+            }
+            for (int a = 0; a < nd; ++a) z[p0 + a] = r[a];
+        }
+    } else ExecError("wendelFricVec: mode must be 0 (Q' x) or 1 ((P Q' K Q + H) x)");
+    y->resize(n);
+    for (long i = 0; i < n; ++i) (*y)[i] = z[i];
+    return n;
+}
+
+long wendelFricQt(const long& nd, KN<long>* const& dof0, KN<double>* const& fE, KN<double>* const& x,
+                  KN<double>* const& y)
+{
+    return fricVec(0, 0, nd, dof0, fE, fE, fE, x, y);
+}
+
+long wendelFricKl(Matrice_Creuse<double>* const& K, const long& nd, KN<long>* const& dof0, KN<double>* const& fE,
+                  KN<double>* const& Pb, KN<double>* const& Hb, KN<double>* const& x, KN<double>* const& y)
+{
+    return fricVec(K, 1, nd, dof0, fE, Pb, Hb, x, y);
+}
+
+long wendelFricRowsPQ(Matrice_Creuse<double>* const& M, const long& n, const long& nd, KN<long>* const& dof0,
+                      KN<double>* const& fE, KN<double>* const& Pb)
+{
+    const long nc = dof0->N(), b2 = nd * nd;
+    fricCheck("wendelFricRowsPQ", n, nd, dof0, fE, Pb);
+    std::vector<int> blk(n, -1);
+    for (long j = 0; j < nc; ++j)
+        for (int a = 0; a < nd; ++a) blk[(*dof0)[j] + a] = (int)j;
+    std::vector<int> rowptr(n + 1, 0), cols;
+    std::vector<double> vals;
+    cols.reserve(n + b2 * nc); vals.reserve(n + b2 * nc);
+    for (long i = 0; i < n; ++i) {
+        const int j = blk[i];
+        if (j < 0) { cols.push_back((int)i); vals.push_back(1.0); }
+        else {
+            const long p0 = (*dof0)[j];
+            const int a = (int)(i - p0);
+            for (int k = 0; k < nd; ++k) {
+                double w = 0;
+                for (int c = 0; c < nd; ++c) w += (*Pb)[b2 * j + nd * a + c] * (*fE)[9 * j + 3 * c + k];
+                cols.push_back((int)(p0 + k)); vals.push_back(w);
+            }
+        }
+        rowptr[i + 1] = (int)cols.size();
+    }
+    M->resize(n, n);
+    HashMatrix<int, double>* HM = M->pHM();
+    if (!HM) ExecError("wendelFricRowsPQ: M is not a sparse matrix");
+    if (M->pMC()) M->pMC()->SetSolver();
+    HM->set((int)n, (int)n, 0, vals.size(), rowptr.data(), cols.data(), vals.data(), 0, 1);
+    return (long)vals.size();
+}
+
 }  // namespace
 
 static void Load_Init()
@@ -206,5 +329,13 @@ static void Load_Init()
     Global.Add("wendelFricFrame", "(",
                new OneOperator8_<long, Matrice_Creuse<double>*, Matrice_Creuse<double>*, long, KN<long>*,
                                  KN<double>*, KN<double>*, KN<double>*, KN<double>*>(wendelFricFrame));
+    Global.Add("wendelFricQt", "(",
+               new OneOperator5_<long, long, KN<long>*, KN<double>*, KN<double>*, KN<double>*>(wendelFricQt));
+    Global.Add("wendelFricKl", "(",
+               new OneOperator8_<long, Matrice_Creuse<double>*, long, KN<long>*, KN<double>*, KN<double>*,
+                                 KN<double>*, KN<double>*, KN<double>*>(wendelFricKl));
+    Global.Add("wendelFricRowsPQ", "(",
+               new OneOperator6_<long, Matrice_Creuse<double>*, long, long, KN<long>*, KN<double>*,
+                                 KN<double>*>(wendelFricRowsPQ));
 }
 LOADFUNC(Load_Init)
