@@ -477,3 +477,35 @@ def test_turning_stl_sphere_gives_lubkins_full_slip_torque(tmp_path):
     active = output.read_array(d / "contact_active.node.txt") > 0.5
     assert active.sum() == last["contact_active_nodes"] > 50
     assert np.abs(t[active] - 0.3 * p[active]).max() <= 1e-8 * p[active].max()
+
+
+@pytest.mark.parametrize("name, extra", [("sliding-block", ""), ("sliding-block-3d", ""),
+                                         ("sliding-block-3d", "force = 2.0e5\ndisplacement = 0.005\n")])
+def test_compiled_frame_change_is_the_freefem_one(tmp_path, name, extra):
+    # fricConstrain's Newton matrix in the contact nodes' local frames, compiled (wendel_tool's wendelFricFrame,
+    # one pass over K) against the FreeFEM language's sparse products: frame = "check" builds both at every
+    # Newton step and records their largest relative difference over the matrix entries and the right-hand
+    # sides (round-off), and a run with each gives the same Newton iterates (residual histories to 1e-8, far
+    # below the 1e-2 a wrong block or a transposed frame gives). 2D Coulomb (the slip rows t + mu s n), 3D (the
+    # slip direction's derivative: P's off-diagonal blocks and H), 3D force control (the second right-hand side).
+    reps = {'friction = { law = "coulomb", mu = 0.3 }': 'friction = { law = "coulomb", mu = 0.3, frame = "FRAME" }'}
+    if extra:
+        reps.update({"z = [0.0, 0.01, 0.01] }": "z = [0.0, 0.0, 0.0] }",
+                     "center = [0.0, 0.0, 0.0] # m": extra + "center = [0.0, 0.0, 0.0] # m"})
+    roots = {}
+    for frame in ("check", "freefem", "compiled"):
+        (tmp_path / frame).mkdir()
+        scene = variant(tmp_path / frame, name, {k: v.replace("FRAME", frame) for k, v in reps.items()})
+        roots[frame] = run(scene, smoke=name.endswith("3d"), out=tmp_path / frame / "out", png=False,
+                           progress=lambda *_: None)
+    check = records(roots["check"])
+    assert len(check) >= 3
+    assert all(r["friction_frame_diff"] < 1e-12 for r in check), [r["friction_frame_diff"] for r in check]
+    assert max(r["friction_slip_nodes"] for r in check) > 0
+    hist = {}
+    for f in ("freefem", "compiled"):
+        with open(roots[f] / "newton.csv") as fh:
+            hist[f] = [(row["increment"], row["iteration"], float(row["residual"])) for row in csv.DictReader(fh)]
+    assert [h[:2] for h in hist["freefem"]] == [h[:2] for h in hist["compiled"]]
+    for a, b in zip(hist["freefem"], hist["compiled"]):
+        assert b[2] == pytest.approx(a[2], rel=1e-8, abs=1e-12 * max(abs(h[2]) for h in hist["freefem"]))

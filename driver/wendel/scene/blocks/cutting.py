@@ -66,6 +66,9 @@ class Cutting(BaseModel):
                                        "default the chip's shear flow stress")
     heat_to_chip: float = Field(0.5, ge=0, le=1, description="share of the frictional heat that enters the "
                                 "chip, the rest the tool [1] (FE)")
+    friction_frame: Literal["compiled", "freefem", "check"] = Field(
+        "compiled", description="FE: the Newton matrix's change to the contact nodes' local frames, as "
+        "contact.friction.frame (compiled, freefem or check)")
     properties_T0: float = Field(273.15, gt=0, description="temperature at which thermal.k and thermal.c hold [K]")
     k_slope: float = Field(0.0, description="dk/dT of the work material [W/m/K^2]")
     c_slope: float = Field(0.0, description="dc/dT of the work material [J/kg/K^2]")

@@ -22,6 +22,9 @@ ROOT = Path(__file__).resolve().parents[4]
 FRICTION_LAWS = {"none": 0, "coulomb": 1, "tresca": 2}
 """Friction law name -> ``-fric_law`` id of friction.idp."""
 FrictionLawName = choice(FRICTION_LAWS, "friction law")
+FRICTION_FRAMES = {"compiled": 0, "freefem": 1, "check": 2}
+"""Frame change name -> ``-fric_frame`` id of friction.idp."""
+FrictionFrameName = choice(FRICTION_FRAMES, "friction frame change")
 
 
 class Friction(BaseModel):
@@ -35,6 +38,11 @@ class Friction(BaseModel):
     tau_max: Optional[float] = Field(None, gt=0, description="Tresca: the slip bound; Coulomb: a cap on the shear traction [Pa]")
     c: float = Field(0.0, ge=0, description="tangential active-set constant [Pa/m]; 0 = the normal one (contact.c)")
     heat_fraction: float = Field(1.0, ge=0, le=1, description="share of the frictional work that heats the body (the rest the tool) [1]")
+    frame: FrictionFrameName = Field("compiled", description="the Newton matrix's change to the contact nodes' "
+                                     "local frames: compiled (one pass over the matrix, plugin wendel_tool), freefem "
+                                     "(the FreeFEM language's sparse products, slower) or check (both; goes on with "
+                                     "the compiled one and records friction_frame_diff, their largest relative "
+                                     "difference); the same matrix up to round-off")
 
     @model_validator(mode="after")
     def _law(self):
@@ -125,7 +133,8 @@ def friction_options(block, files) -> list[str]:
     wendel.loop.launch.macros); the path and polygon tables are written into the run's tables folder (numbers only)."""
     f = block.friction or Friction(law="none")
     opts = ["-fric_law", str(FRICTION_LAWS[f.law]), "-fric_mu", repr(f.mu),
-            "-fric_tau", repr(f.tau_max or 0.0), "-fric_c", repr(f.c), "-fric_heat_fraction", repr(f.heat_fraction)]
+            "-fric_tau", repr(f.tau_max or 0.0), "-fric_c", repr(f.c), "-fric_heat_fraction", repr(f.heat_fraction),
+            "-fric_frame", str(FRICTION_FRAMES[f.frame])]
     if block.force is not None:
         opts += ["-tool_force", repr(block.force), "-tool_force_tol", repr(block.force_tol)]
     if files is None:
