@@ -121,6 +121,17 @@ double wendelTriDistance(KN<double>* const& tris, KN<double>* const& y, KN<doubl
 }
 
 
+// Replace the FreeFEM matrix A by the n x n matrix in CSR (rowptr, cols, vals); who names the caller in errors.
+static void fricSetCsr(Matrice_Creuse<double>* A, long n, std::vector<int>& rowptr, std::vector<int>& cols,
+                       std::vector<double>& vals, const char* who)
+{
+    A->resize(n, n);
+    HashMatrix<int, double>* H = A->pHM();
+    if (!H) ExecError(std::string(who) + ": the result is not a sparse matrix");
+    if (A->pMC()) A->pMC()->SetSolver();
+    H->set((int)n, (int)n, 0, vals.size(), rowptr.data(), cols.data(), vals.data(), 0, 1);
+}
+
 // The frame change of lib/friction.idp's Newton matrix (see the head of the file): A = L K R + B.
 long wendelFricFrame(Matrice_Creuse<double>* const& A, Matrice_Creuse<double>* const& K, const long& nd,
                      KN<long>* const& dof0, KN<double>* const& fE, KN<double>* const& Pb, KN<double>* const& Hb,
@@ -198,11 +209,7 @@ long wendelFricFrame(Matrice_Creuse<double>* const& A, Matrice_Creuse<double>* c
         for (int c : touched) { cols.push_back(c); vals.push_back(w[c]); }
         rowptr[i + 1] = (int)cols.size();
     }
-    A->resize(n, n);
-    HashMatrix<int, double>* HA = A->pHM();
-    if (!HA) ExecError("wendelFricFrame: A is not a sparse matrix");
-    if (A->pMC()) A->pMC()->SetSolver();
-    HA->set((int)n, (int)n, 0, vals.size(), rowptr.data(), cols.data(), vals.data(), 0, 1);
+    fricSetCsr(A, n, rowptr, cols, vals, "wendelFricFrame");
     return (long)vals.size();
 }
 
@@ -312,11 +319,7 @@ long wendelFricRowsPQ(Matrice_Creuse<double>* const& M, const long& n, const lon
         }
         rowptr[i + 1] = (int)cols.size();
     }
-    M->resize(n, n);
-    HashMatrix<int, double>* HM = M->pHM();
-    if (!HM) ExecError("wendelFricRowsPQ: M is not a sparse matrix");
-    if (M->pMC()) M->pMC()->SetSolver();
-    HM->set((int)n, (int)n, 0, vals.size(), rowptr.data(), cols.data(), vals.data(), 0, 1);
+    fricSetCsr(M, n, rowptr, cols, vals, "wendelFricRowsPQ");
     return (long)vals.size();
 }
 
