@@ -509,8 +509,11 @@ class Process:
         (root / "drilling.json").write_text(json.dumps({**out, "steps": rows, "profiles": self.profiles}, indent=1))
         if self.scene.output.png:
             plots(root, rows, self.probes, self.profiles)
-        self.progress(f"  heat in {heat_in:.4g} J = stored {d_energy:.4g} + chips {chips:.4g} - convection {conv:.4g}"
-                      f" - thermoelastic {te:.3g}; mismatch {abs(mismatch) / scale:.2e} (transfer defect {defect:.3g} J)")
+        # the ledger as the README states it: what came in = where it went (conv and te are gains, so losses negative)
+        plastic_in = f" + plastic {plastic:.4g} J" if plastic else ""
+        self.progress(f"  heat in {heat_in:.4g} J{plastic_in} = stored {d_energy:.4g} + chips {chips:.4g}"
+                      f" + convected out {-conv:.4g} + thermoelastic {-te:.3g}; mismatch {abs(mismatch) / scale:.2e}"
+                      f" (transfer defect {defect:.3g} J)")
         pics = [n for n in ("probes.png", "bore.png", "energy.png") if (root / n).is_file()]
         if pics:
             self.progress(f"  pictures: {', '.join(str(root / n) for n in pics)}")
