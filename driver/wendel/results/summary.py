@@ -141,7 +141,7 @@ def write_summary(root: Path, scene, state, dimension: int, picture: float | Non
     the run waited for deformed.png, its own phase)."""
     records = read_records(root)
     phases = {"mesh": state.mesh_seconds, "freefem_startup": 0.0, "assembly": 0.0, "linear_solve": 0.0,
-              "constitutive": 0.0, "freefem_output": 0.0, "freefem_other": 0.0,
+              "constitutive": 0.0, "freefem_output": 0.0, "freefem_other": 0.0, "failed_increments": 0.0,
               "driver_output": state.post_seconds}
     # FreeFEM's clocks are cumulative within a launch: take the last record of each launch.
     by_launch, idx = [], 0
@@ -154,7 +154,12 @@ def write_summary(root: Path, scene, state, dimension: int, picture: float | Non
         if rec is None:
             continue
         inner = rec["time_total"]
-        phases["freefem_startup"] += max(launch["wall"] - inner, 0.0)
+        # FreeFEM's clock at the launch's end (a failed increment, or increments rolled back): the time past the
+        # last kept increment is failed increments' Newton work, not start-up (issue 17, session 10: the
+        # "start-up" of 35-74 s on the 300 um cut was mostly this)
+        end = max(launch.get("freefem_end", inner), inner)
+        phases["freefem_startup"] += max(launch["wall"] - end, 0.0)
+        phases["failed_increments"] += end - inner
         phases["assembly"] += rec["time_assembly"]
         phases["linear_solve"] += rec["time_solve"]
         phases["constitutive"] += rec["time_constitutive"]
