@@ -480,6 +480,7 @@ long wendelFricResidual(KN<double>* const& toolp, KN<double>* const& parp, KN<lo
     const double* pl = &par[0];
     const double* plOld = &par[4];
     const int law = (int)par[8];
+    if (law < 0 || law > 2) ExecError("wendelFricResidual: par[8] (law) must be 0, 1 or 2");
     const double mu = par[9], tau = par[10], cN = par[11], ct0 = par[12], ctPred = par[13], heatFr = par[14], dirTol = par[15];
     const double dirC = tool[3];
     out->resize(kFricOut * nc + kFricTotals);
