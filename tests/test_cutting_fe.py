@@ -91,3 +91,19 @@ def test_fe_cut_forms_a_chip(tmp_path):
     travel = [c["tool_travel_m"] for c in st["cycle_means"]]
     assert len(travel) >= 4 and all(c["increments"] >= 2 for c in st["cycle_means"]) and np.all(np.diff(travel) > 0)
     assert (root / "chip.gif").stat().st_size > 10000
+
+
+def test_fe_cut_compiled_residual_pass_is_the_freefem_one(tmp_path):
+    # friction.idp's pass over the contact nodes at each residual on the cut (the rounded polygon tool moving
+    # along its path, the current masses of the updated-Lagrangian surface, Coulomb with the shear cap),
+    # compiled against the FreeFEM language's loop: friction_residual = "check" runs both at every residual
+    # (line searches included) and records their largest relative difference: exactly 0 (the same arithmetic in
+    # the same order), also after a remesh.
+    scene = load(STEEL, smoke=True)
+    scene.cutting.friction_residual = "check"
+    scene.cutting.remesh_every = 2
+    root = run_cut(scene, STEEL, tmp_path / "cut", smoke=True, progress=lambda *_: None, frames=False)
+    recs = [json.loads((d / "record.json").read_text()) for d in sorted((root / "fem").glob("inc-*"))
+            if (d / "done").is_file()]
+    assert len(recs) >= 4 and max(r["friction_slip_nodes"] for r in recs) > 0
+    assert all(r["friction_residual_diff"] == 0.0 for r in recs), [r["friction_residual_diff"] for r in recs]

@@ -509,3 +509,46 @@ def test_compiled_frame_change_is_the_freefem_one(tmp_path, name, extra):
     assert [h[:2] for h in hist["freefem"]] == [h[:2] for h in hist["compiled"]]
     for a, b in zip(hist["freefem"], hist["compiled"]):
         assert b[2] == pytest.approx(a[2], rel=1e-8, abs=1e-12 * max(abs(h[2]) for h in hist["freefem"]))
+
+
+
+CHECK_RESIDUAL = {"sliding-block": 'friction = { law = "coulomb", mu = 0.3 }',
+                  "sliding-block-3d": 'friction = { law = "coulomb", mu = 0.3 }',
+                  "scratch": 'friction = { law = "coulomb", mu = 0.2 }'}
+
+
+@pytest.mark.parametrize("name, reps, smoke", [
+    ("sliding-block", {}, False),
+    ("sliding-block", {"coulomb\", mu = 0.3": "tresca\", tau_max = 3.0e4"}, False),
+    ("sliding-block-3d", {"z = [0.0, 0.01, 0.01] }": "z = [0.0, 0.0, 0.0] }",
+                          "center = [0.0, 0.0, 0.0] # m": "force = 2.0e5\ndisplacement = 0.005\ncenter = [0.0, 0.0, 0.0] # m"},
+     True),
+    ("scratch", {}, True),
+    ("stl-ball", {"displacement = -0.01     # m, along -z at load factor 1": "displacement = 0.0       # m",
+                  "# closed surface, m, at load factor 0 (wendel.scene.stl.sphere)":
+                  '\nfriction = { law = "coulomb", mu = 0.3, residual = "check" }\n'
+                  'path = { load_factors = [0.0, 1.0, 2.0], z = [0.0, -0.01, -0.01], angle = [0.0, 0.0, 30.0], axis = [0.0, 0.0, 1.0] }',
+                  "steps = 1": "factors = [1.0, 1.2, 1.4]"}, False)])
+def test_compiled_residual_pass_is_the_freefem_one(tmp_path, name, reps, smoke):
+    # fricResidual's pass over the contact nodes (the tool's distance and normal, the slip, the frame, the
+    # sets, the rows; the current masses under the updated-Lagrangian kinematics), compiled (wendel_tool's
+    # wendelFricResidual) against the FreeFEM language's loop: residual = "check" runs both at every residual
+    # and records their largest relative difference over the nodes' arrays and the residual (1 if a set or a
+    # count differs). They do the same arithmetic in the same order (x^2 through libm's pow, as FreeFEM does;
+    # x * x gave 1e-16 in the scratch's frames, 6e-13 in its rows): exactly 0. 2D Coulomb and Tresca on a plane,
+    # 3D with force control, the scratch's rounded polygon (curvature, large sliding), the turning STL sphere
+    # (the triangulated tool, a rotating placement).
+    reps = dict(reps)
+    if name in CHECK_RESIDUAL:
+        reps = {CHECK_RESIDUAL[name]: CHECK_RESIDUAL[name][:-2] + ', residual = "check" }', **reps}
+    text = (WORKFLOWS / f"{name}.toml").read_text()
+    for old, new in reps.items():
+        assert old in text, old
+        text = text.replace(old, new)
+    scene = tmp_path / f"{name}-check.toml"
+    scene.write_text(text)
+    root = run(scene, smoke=smoke, out=tmp_path / "out", png=False, progress=lambda *_: None)
+    recs = records(root)
+    assert len(recs) >= 3
+    assert all(r["friction_residual_diff"] == 0.0 for r in recs), [r["friction_residual_diff"] for r in recs]
+    assert max(r["friction_slip_nodes"] for r in recs) > 0

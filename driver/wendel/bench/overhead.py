@@ -111,7 +111,8 @@ def shares(root: Path) -> dict:
         ph["freefem_startup"] = max(ph["freefem_startup"] - ph["driver_output"], 0.0)
     solve = sum(ph[k] for k in SOLVE)
     wall = ph["mesh"] + ph["freefem_startup"] + solve + ph["freefem_output"] + ph["freefem_other"] \
-        + ph["driver_output"] + ph.get("failed_launches", 0.0) + ph["remesh"] + picture
+        + ph["driver_output"] + ph.get("failed_launches", 0.0) + ph.get("failed_increments", 0.0) + ph["remesh"] \
+        + picture
     row = {"dofs": s.get("dofs"), "increments": s["increments"], "launches": s["launches"], "wall": wall,
            "solve": solve, "startup": ph["freefem_startup"], "mesh": ph["mesh"],
            "freefem_output": ph["freefem_output"], "freefem_other": ph["freefem_other"],

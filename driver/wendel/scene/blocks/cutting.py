@@ -69,6 +69,9 @@ class Cutting(BaseModel):
     friction_frame: Literal["compiled", "freefem", "check"] = Field(
         "compiled", description="FE: the Newton matrix's change to the contact nodes' local frames, as "
         "contact.friction.frame (compiled, freefem or check)")
+    friction_residual: Literal["compiled", "freefem", "check"] = Field(
+        "compiled", description="FE: the pass over the contact nodes at each residual (tool distance, sets, rows, "
+        "masses), as contact.friction.residual (compiled, freefem or check)")
     properties_T0: float = Field(273.15, gt=0, description="temperature at which thermal.k and thermal.c hold [K]")
     k_slope: float = Field(0.0, description="dk/dT of the work material [W/m/K^2]")
     c_slope: float = Field(0.0, description="dc/dT of the work material [J/kg/K^2]")

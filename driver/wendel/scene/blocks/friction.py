@@ -25,6 +25,9 @@ FrictionLawName = choice(FRICTION_LAWS, "friction law")
 FRICTION_FRAMES = {"compiled": 0, "freefem": 1, "check": 2}
 """Frame change name -> ``-fric_frame`` id of friction.idp."""
 FrictionFrameName = choice(FRICTION_FRAMES, "friction frame change")
+FRICTION_RESIDUALS = {"compiled": 0, "freefem": 1, "check": 2}
+"""Residual pass name -> ``-fric_residual`` id of friction.idp."""
+FrictionResidualName = choice(FRICTION_RESIDUALS, "friction residual pass")
 
 
 class Friction(BaseModel):
@@ -43,6 +46,12 @@ class Friction(BaseModel):
                                      "(the FreeFEM language's sparse products, slower) or check (both; goes on with "
                                      "the compiled one and records friction_frame_diff, their largest relative "
                                      "difference); the same matrix up to round-off")
+    residual: FrictionResidualName = Field("compiled", description="the pass over the contact nodes at each "
+                                           "residual (the tool's distance, frames, slips, stick/slip sets, rows and "
+                                           "current masses): compiled (plugin wendel_tool), freefem (the FreeFEM "
+                                           "language's loop, slower) or check (both; goes on with the compiled one "
+                                           "and records friction_residual_diff, their largest relative difference); "
+                                           "the same numbers")
 
     @model_validator(mode="after")
     def _law(self):
@@ -134,7 +143,7 @@ def friction_options(block, files) -> list[str]:
     f = block.friction or Friction(law="none")
     opts = ["-fric_law", str(FRICTION_LAWS[f.law]), "-fric_mu", repr(f.mu),
             "-fric_tau", repr(f.tau_max or 0.0), "-fric_c", repr(f.c), "-fric_heat_fraction", repr(f.heat_fraction),
-            "-fric_frame", str(FRICTION_FRAMES[f.frame])]
+            "-fric_frame", str(FRICTION_FRAMES[f.frame]), "-fric_residual", str(FRICTION_RESIDUALS[f.residual])]
     if block.force is not None:
         opts += ["-tool_force", repr(block.force), "-tool_force_tol", repr(block.force_tol)]
     if files is None:
