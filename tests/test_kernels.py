@@ -106,6 +106,27 @@ def test_rank_local_constitutive_state_on_two_petsc_ranks(tmp_path):
     assert plastic[1] > 0 and plastic[2] > plastic[1]      # the later increments start from a plastic state
 
 
+def test_failed_increment_record_on_two_petsc_ranks(tmp_path):
+    """A failed increment's record from the rank-local state made whole (kernelGatherTrial): the plastic points
+    and the stiffness ratio of the FreeFEM-language tangent of 1 PETSc rank."""
+    from wendel.loop import run_scene
+    from wendel.scene import load
+
+    path = WORKFLOWS / "ball-indent.toml"
+    failed = []
+    for ranks in (1, 2):
+        scene = load(path, smoke=True)
+        scene.numerics.solver, scene.numerics.ranks, scene.numerics.assembly = "petsc", ranks, "compiled"
+        scene.numerics.newton_maxit, scene.loading.max_cuts = 2, 0         # Newton stops before it converges
+        scene.output.png = scene.output.vtu = False
+        with pytest.raises(Exception, match="Newton did not converge"):
+            run_scene(scene, path, tmp_path / f"np{ranks}", smoke=True, progress=lambda *_: None)
+        failed.append(json.loads((tmp_path / f"np{ranks}" / "fem" / "failed.json").read_text()))
+    one, two = failed
+    assert one["plastic_points"] == two["plastic_points"] > 0
+    assert two["stiffness_ratio"] == pytest.approx(one["stiffness_ratio"], rel=1e-9)
+
+
 def test_compiled_kernels_with_the_direct_solver(tmp_path):
     """The direct solver factorizes the kernels' matrix (contact lifted through K, not masked): the same iterates."""
     (f, uf), (c, uc) = (ball(tmp_path / a, a, solver="direct") for a in ("freefem", "compiled"))
