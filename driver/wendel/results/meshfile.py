@@ -8,7 +8,7 @@ shared by every caller: read from it, copy what you change (:func:`wendel.result
 :func:`wendel.remesh.mesher.read_mesh` return copies).
 
 gmsh's ASCII MSH 2.2 with only the sections wendel's meshes have (PhysicalNames, Nodes, Elements with two tags)
-is parsed with numpy (:func:`read_msh22`): 0.17 s against meshio's 0.84-1.3 s for the step-42 ball at 217k
+is parsed with numpy (:func:`read_msh22`): 0.22 s against meshio's 0.84-1.38 s for the step-42 ball at 217k
 tetrahedra, the driver's accept after the last FreeFEM increment on every run; the same Mesh as meshio's (test).
 Anything else goes to meshio.
 """
