@@ -69,6 +69,64 @@ def test_compiled_kernels_on_two_petsc_ranks(tmp_path, ball_freefem):
     assert np.abs(uc - uf).max() <= 1e-7 * np.abs(uf).max()
 
 
+def test_rank_local_constitutive_state_on_two_petsc_ranks(tmp_path):
+    """Each of 2 PETSc ranks updates the quadrature points of its own tetrahedra only (kernels.idp, kernelPoints)
+    and gathers the state where it is needed whole (kernelGather): over 3 increments of a moving ball, each
+    starting from the gathered state of the last, every written field and checkpoint array (plastic strain,
+    p, yield stress at the quadrature points, cell stress and strain) of 1 PETSc rank, and its records."""
+    from wendel.loop import run_scene
+    from wendel.scene import load
+
+    path = WORKFLOWS / "ball-indent.toml"
+    runs = []
+    for ranks in (1, 2):
+        scene = load(path, smoke=True)
+        scene.numerics.solver, scene.numerics.ranks, scene.numerics.assembly = "petsc", ranks, "compiled"
+        scene.loading.steps = 3
+        scene.contact.center, scene.contact.displacement = [0.5, 0.5, 1.6], -0.02   # in contact from increment 2
+        scene.output.png = scene.output.vtu = False
+        runs.append(run_scene(scene, path, tmp_path / f"np{ranks}", smoke=True, progress=lambda *_: None) / "fem")
+    one, two = runs
+    incs = sorted(d.name for d in one.glob("inc-*"))
+    assert incs == sorted(d.name for d in two.glob("inc-*")) and len(incs) == 3
+    plastic = []
+    for inc in incs:
+        r1, r2 = (json.loads((f / inc / "record.json").read_text()) for f in runs)
+        assert r2["ranks"] == 2 and r2["newton_iterations"] == r1["newton_iterations"]
+        assert r2["plastic_points"] == r1["plastic_points"]
+        for key in ("contact_force", "max_von_mises", "plastic_volume", "max_plastic_strain", "strain_energy"):
+            assert r2[key] == pytest.approx(r1[key], rel=1e-9, abs=1e-300), (inc, key)
+        plastic.append(r1["plastic_points"])
+        names = sorted(f.name for f in (one / inc).glob("*.txt") if f.name != "newton.csv")
+        assert {"plast_epsp.qp.txt", "plast_p.qp.txt", "plast_sigma_y.qp.txt", "vonMises.cell.txt",
+                "strain_xy.cell.txt", "epsp_xx.cell.txt"} <= set(names)
+        for name in names:
+            a, b = read_array(one / inc / name), read_array(two / inc / name)
+            assert a.shape == b.shape and np.abs(b - a).max() <= 1e-9 * max(np.abs(a).max(), 1e-300), (inc, name)
+    assert plastic[1] > 0 and plastic[2] > plastic[1]      # the later increments start from a plastic state
+
+
+def test_failed_increment_record_on_two_petsc_ranks(tmp_path):
+    """A failed increment's record from the rank-local state made whole (kernelGatherTrial): the plastic points
+    and the stiffness ratio of the FreeFEM-language tangent of 1 PETSc rank."""
+    from wendel.loop import run_scene
+    from wendel.scene import load
+
+    path = WORKFLOWS / "ball-indent.toml"
+    failed = []
+    for ranks in (1, 2):
+        scene = load(path, smoke=True)
+        scene.numerics.solver, scene.numerics.ranks, scene.numerics.assembly = "petsc", ranks, "compiled"
+        scene.numerics.newton_maxit, scene.loading.max_cuts = 2, 0         # Newton stops before it converges
+        scene.output.png = scene.output.vtu = False
+        with pytest.raises(Exception, match="Newton did not converge"):
+            run_scene(scene, path, tmp_path / f"np{ranks}", smoke=True, progress=lambda *_: None)
+        failed.append(json.loads((tmp_path / f"np{ranks}" / "fem" / "failed.json").read_text()))
+    one, two = failed
+    assert one["plastic_points"] == two["plastic_points"] > 0
+    assert two["stiffness_ratio"] == pytest.approx(one["stiffness_ratio"], rel=1e-9)
+
+
 def test_compiled_kernels_with_the_direct_solver(tmp_path):
     """The direct solver factorizes the kernels' matrix (contact lifted through K, not masked): the same iterates."""
     (f, uf), (c, uc) = (ball(tmp_path / a, a, solver="direct") for a in ("freefem", "compiled"))

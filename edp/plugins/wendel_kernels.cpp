@@ -13,7 +13,8 @@
 //       sqrt2 xz, sqrt2 xy], component-major: 6 arrays of nt values); the rows with fix > 0.5 are zeroed
 //       with 1 on the diagonal (FreeFEM's tgv = -1). DoFs of [P1, P1, P1]: 3 vertex + component.
 //   long wendelStrain3(mesh3 Th, real[int] u, real[int] eps);
-//       eps (resized to 6 nt) = Mandel strain of the P1 displacement u per tetrahedron, component-major.
+//       eps (resized to 6 nt) = Mandel strain of the P1 displacement u per tetrahedron, component-major; after
+//       wendelPart3 on 2+ ranks, of this rank's tetrahedra only (the others' entries 0).
 //   long wendelInternal3(mesh3 Th, real[int] sig, real[int] f);
 //       f (resized to 3 nv) = the integral of sig : eps(v) (sig Mandel per tetrahedron, component-major).
 //   long wendelPart3(mesh3 Th, long rank, long size, real[int] order);
@@ -24,6 +25,11 @@
 //       wendelTangent3 and wendelInternal3 sum over this rank's tetrahedra only (K and f are this rank's
 //       parts: the sum over the ranks is the whole), and wendelTangent3 leaves the fixed rows to the solver
 //       (no 1 on their diagonal). size 1 undoes it. Returns the number of this rank's tetrahedra.
+//   long wendelPartPoints(mesh3 Th, long ncomp, int[int] idx);
+//       idx (resized to ncomp times this rank's tetrahedron count) = c nt + k for every component c < ncomp
+//       and every tetrahedron k of this rank (wendelPart3), component-major, k ascending: the positions of
+//       this rank's quadrature points in a component-major array of ncomp nt values (one point per
+//       tetrahedron). Every tetrahedron when not partitioned. Returns idx's size.
 //
 // The CSR pattern of K (every vertex pair of a tetrahedron, 3 x 3 blocks, sorted columns) and the position
 // of each tetrahedron's blocks in it are kept for the last mesh (its address, vertex and element counts).
@@ -188,8 +194,11 @@ long wendelStrain3(const Mesh3* const& pTh, KN<double>* const& u, KN<double>* co
     const long nt = Th.nt;
     if (u->N() != 3 * Th.nv) ExecError("wendelStrain3: u needs 3 values per vertex");
     eps->resize(6 * nt);
+    checkPart(Th);
+    if (!own.empty()) *eps = 0.0;
     double g[4][3];
     for (long k = 0; k < nt; ++k) {
+        if (!mine(k)) continue;
         const Tet& T = Th[k];
         gradients(T, g);
         double G[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};   // G[c][j] = d u_c / d x_j
@@ -276,6 +285,22 @@ long wendelPart3(const Mesh3* const& pTh, const long& rank, const long& size, KN
     return mineCount;
 }
 
+long wendelPartPoints(const Mesh3* const& pTh, const long& ncomp, KN<long>* const& idx)
+{
+    const Mesh3& Th = *pTh;
+    const long nt = Th.nt;
+    if (ncomp < 1) ExecError("wendelPartPoints: ncomp must be >= 1");
+    checkPart(Th);
+    long n = 0;
+    for (long k = 0; k < nt; ++k) n += mine(k);
+    idx->resize(ncomp * n);
+    long pos = 0;
+    for (long c = 0; c < ncomp; ++c)
+        for (long k = 0; k < nt; ++k)
+            if (mine(k)) (*idx)[pos++] = c * nt + k;
+    return ncomp * n;
+}
+
 }  // namespace
 
 static void Load_Init()
@@ -287,5 +312,7 @@ static void Load_Init()
     Global.Add("wendelInternal3", "(",
                new OneOperator3_<long, const Mesh3*, KN<double>*, KN<double>*>(wendelInternal3));
     Global.Add("wendelPart3", "(", new OneOperator4_<long, const Mesh3*, long, long, KN<double>*>(wendelPart3));
+    Global.Add("wendelPartPoints", "(",
+               new OneOperator3_<long, const Mesh3*, long, KN<long>*>(wendelPartPoints));
 }
 LOADFUNC(Load_Init)
