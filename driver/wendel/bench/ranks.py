@@ -21,7 +21,7 @@ from . import WORKFLOWS, register
 from .petsc import measure
 
 PHASES = ("mesh", "freefem_startup", "assembly", "constitutive", "linear_solve", "freefem_output", "freefem_other",
-          "driver_output")
+          "failed_increments", "driver_output")
 
 
 def _row(out: Path, h: float, ranks: int) -> dict:
