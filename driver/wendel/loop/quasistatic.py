@@ -168,21 +168,6 @@ def build(scene: Scene, files: RunFiles) -> tuple[float, int]:
     return time.perf_counter() - t0, dimension
 
 
-def _freefem_end(files: RunFiles, state: State, failure, before: int) -> float | None:
-    """FreeFEM's own clock when the launch ended: at a failed increment its failed.json's ``time_total``,
-    otherwise the last committed increment's (read before a roll back drops increments). The summary counts the
-    time between the last kept increment and this as failed increments, not as start-up."""
-    if failure is not None:
-        end = failure.record.get("time_total")
-        return float(end) if end is not None else None
-    if len(state.accepted) == before:
-        return None
-    try:
-        return float(json.loads((files.fem / f"inc-{state.last[0]:04d}" / "record.json").read_text())["time_total"])
-    except (OSError, ValueError, KeyError):
-        return None
-
-
 def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress) -> None:
     """Launch FreeFEM on the pending increments; cut failing steps; remesh when the mesh distorts.
 
@@ -228,11 +213,9 @@ def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress)
             state.post_seconds += behind.waited
             if behind.error is None:
                 accept(scene, files, state, dimension)
-            state.launches.append({"wall": wall, "increments": len(state.accepted) - before,
-                                   "complete": failure is None})
-            end = _freefem_end(files, state, failure, before)
-            if end is not None:
-                state.launches[-1]["freefem_end"] = end
+            ended = state.last[0] if len(state.accepted) > before else None      # FreeFEM's clock at the end
+            state.launches.append({"wall": wall, "increments": len(state.accepted) - before, "complete": failure is None,
+                                   **summary.launch_end(files.fem, ended, failure and failure.record)})
         stopped = bool(stop_args) and remesh_batch.settle(scene, files, state, dimension, inc0, progress)
         failure = None if stopped else failure
         if state.reequilibrate and state.accepted and state.last[0] >= state.segments[-1]["first"]:
@@ -300,8 +283,7 @@ def accept(scene: Scene, files: RunFiles, state: State, dimension: int) -> None:
         summary.append_history(files.root, separated.history_row(record, extra, seg), d / "newton.csv")
         _save_checkpoint(files, scene, state, dimension)
     if scene.output.vtu and state.accepted:
-        vtu.write_pvd(files.root / "results.pvd",
-                         [(lf, f"vtu/inc-{i:04d}.vtu") for i, lf in state.accepted])
+        vtu.write_pvd(files.root / "results.pvd", [(lf, f"vtu/inc-{i:04d}.vtu") for i, lf in state.accepted])
     state.post_seconds += time.perf_counter() - t0
 
 

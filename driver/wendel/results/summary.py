@@ -136,6 +136,26 @@ def read_records(root: Path) -> list[dict]:
             for d in sorted((root / "fem").glob("inc-*")) if (d / "done").is_file()]
 
 
+def launch_end(fem: Path, last: int | None, failed: dict | None) -> dict:
+    """``{"freefem_end": FreeFEM's own clock when a launch ended}`` for :func:`launch_phases`: at a failed
+    increment its failed.json's ``time_total`` (``failed``), otherwise that of the launch's last committed
+    increment ``last`` (read before a roll back drops increments); ``{}`` when neither is known. The time between
+    the last kept increment and this end counts as failed increments, not as start-up.
+
+    >>> launch_end(Path("."), None, {"time_total": 7.5}), launch_end(Path("."), None, None)
+    ({'freefem_end': 7.5}, {})
+    """
+    try:
+        if failed is not None:
+            return {"freefem_end": float(failed["time_total"])}
+        if last is not None:
+            record = json.loads((fem / f"inc-{last:04d}" / "record.json").read_text())
+            return {"freefem_end": float(record["time_total"])}
+    except (OSError, ValueError, KeyError, TypeError):
+        pass
+    return {}
+
+
 def launch_phases(launches: list[dict], records: list[dict]) -> dict:
     """Wall time by phase of FreeFEM's launches from their wall times (the driver's) and FreeFEM's clocks,
     cumulative within a launch (so the last record of each launch counts). Start-up (and exit) is a launch's

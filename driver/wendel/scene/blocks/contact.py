@@ -15,7 +15,7 @@ Friction, a tool of any shape (2D polygon), a tool path or force control switch 
 (current configuration, 2D and 3D) through the extra macro ``-DWITHFRICTION=1`` (wendel.loop.launch.macros):
 
 >>> c = Contact(boundary="bottom", normal="-y", friction={"law": "coulomb", "mu": 0.3})
->>> c.current_configuration, options(c, None, None)[-12:-8]
+>>> c.current_configuration, options(c, None, None)[-14:-10]
 (True, ['-fric_law', '1', '-fric_mu', '0.3'])
 
 The scalar membrane obstacle problem (deal.II step-41, ``edp/obstacle.edp``) is the problem
