@@ -127,6 +127,28 @@ def test_behind_moves_its_seconds_and_raises_its_error_at_the_end():
     assert len(calls) == 3
 
 
+def test_behind_keeps_an_interrupt_that_comes_while_a_failing_launch_joins_its_thread():
+    """An interrupt (Ctrl-C, SIGTERM) while Behind's end waits for its thread outranks the error the block
+    ended with (a step to cut): it used to be dropped, and the run went on to the end with exit 0 (a CI run of
+    tests/test_interrupt.py saw it)."""
+    import os
+    import signal
+    import threading
+    import time
+
+    from wendel.loop import overlap
+    from wendel.loop.checkpoint import State
+
+    def work():                              # the thread is busy when the block ends
+        time.sleep(6 * overlap.POLL)
+
+    with pytest.raises(KeyboardInterrupt):
+        with overlap.Behind(work, State()):
+            time.sleep(1.5 * overlap.POLL)   # the thread is in work()
+            threading.Timer(overlap.POLL, os.kill, (os.getpid(), signal.SIGINT)).start()
+            raise ValueError("the launch failed: cut the step")
+
+
 def test_accepting_while_freefem_solves_gives_the_same_run(tmp_path, monkeypatch):
     """upsetting (smoke, remeshing): increments accepted in a thread during the launch (overlap.Behind) give
     the run of the accept after each launch: increments, Newton iterations, remeshes, histories, fields."""

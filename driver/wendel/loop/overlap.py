@@ -68,7 +68,7 @@ class Behind:
             except KeyboardInterrupt:
                 interrupted = True
         self.waited = time.perf_counter() - self.ended
-        if interrupted and exc[0] is None:
+        if interrupted:                     # an interrupt outranks the block's own error (a step to cut)
             raise KeyboardInterrupt
         if self.error is not None and exc[0] is None:
             raise self.error             # as if the accept after the launch had raised it
