@@ -142,11 +142,17 @@ def test_behind_keeps_an_interrupt_that_comes_while_a_failing_launch_joins_its_t
     def work():                              # the thread is busy when the block ends
         time.sleep(6 * overlap.POLL)
 
-    with pytest.raises(KeyboardInterrupt):
-        with overlap.Behind(work, State()):
-            time.sleep(1.5 * overlap.POLL)   # the thread is in work()
-            threading.Timer(overlap.POLL, os.kill, (os.getpid(), signal.SIGINT)).start()
-            raise ValueError("the launch failed: cut the step")
+    # Python's SIGINT handler set again: gmsh, initialized by earlier tests in this process, resets it to the
+    # default action at the C level (which would end pytest itself)
+    before = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            with overlap.Behind(work, State()):
+                time.sleep(1.5 * overlap.POLL)   # the thread is in work()
+                threading.Timer(overlap.POLL, os.kill, (os.getpid(), signal.SIGINT)).start()
+                raise ValueError("the launch failed: cut the step")
+    finally:
+        signal.signal(signal.SIGINT, before if before is not None else signal.SIG_DFL)
 
 
 def test_accepting_while_freefem_solves_gives_the_same_run(tmp_path, monkeypatch):
