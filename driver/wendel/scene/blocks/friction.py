@@ -22,12 +22,11 @@ ROOT = Path(__file__).resolve().parents[4]
 FRICTION_LAWS = {"none": 0, "coulomb": 1, "tresca": 2}
 """Friction law name -> ``-fric_law`` id of friction.idp."""
 FrictionLawName = choice(FRICTION_LAWS, "friction law")
-FRICTION_FRAMES = {"compiled": 0, "freefem": 1, "check": 2}
-"""Frame change name -> ``-fric_frame`` id of friction.idp."""
-FrictionFrameName = choice(FRICTION_FRAMES, "friction frame change")
-FRICTION_RESIDUALS = {"compiled": 0, "freefem": 1, "check": 2}
-"""Residual pass name -> ``-fric_residual`` id of friction.idp."""
-FrictionResidualName = choice(FRICTION_RESIDUALS, "friction residual pass")
+FRICTION_PASSES = {"compiled": 0, "freefem": 1, "check": 2}
+"""How friction.idp does one of its passes over the contact nodes -> its id in ``-fric_frame`` (the Newton
+matrix's frame change) and ``-fric_residual`` (the residual pass)."""
+FrictionFrameName = choice(FRICTION_PASSES, "friction frame change")
+FrictionResidualName = choice(FRICTION_PASSES, "friction residual pass")
 
 
 class Friction(BaseModel):
@@ -143,7 +142,7 @@ def friction_options(block, files) -> list[str]:
     f = block.friction or Friction(law="none")
     opts = ["-fric_law", str(FRICTION_LAWS[f.law]), "-fric_mu", repr(f.mu),
             "-fric_tau", repr(f.tau_max or 0.0), "-fric_c", repr(f.c), "-fric_heat_fraction", repr(f.heat_fraction),
-            "-fric_frame", str(FRICTION_FRAMES[f.frame]), "-fric_residual", str(FRICTION_RESIDUALS[f.residual])]
+            "-fric_frame", str(FRICTION_PASSES[f.frame]), "-fric_residual", str(FRICTION_PASSES[f.residual])]
     if block.force is not None:
         opts += ["-tool_force", repr(block.force), "-tool_force_tol", repr(block.force_tol)]
     if files is None:
