@@ -22,7 +22,7 @@ from __future__ import annotations
 import inspect
 import math
 import typing
-from typing import Annotated, Any, Optional
+from typing import Annotated, Any, Literal, Optional
 
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, ValidationError, create_model, model_validator
 
@@ -80,6 +80,7 @@ KNOWN: dict[str, Any] = {
     # orthogonal-cutting
     "depth": Length, "uncut": Length, "pre_cut": Length, "band": Annotated[float, Field(gt=0)],
     "fine": Annotated[float, Field(gt=0, le=1)],
+    "algorithm": Literal["delaunay", "hxt"],
 }
 
 
@@ -96,6 +97,8 @@ HELP = {
     "pre_cut": "length of the machined step the tool starts against [m]",
     "band": "depth of the refined band below the machined level, in uncut thicknesses [1]",
     "fine": "element size in the refined band as a fraction of h [1]",
+    "algorithm": "3D: gmsh's tetrahedral algorithm, delaunay (gmsh's default) or hxt (3-10x faster meshing "
+                 "without Netgen's optimization: `wendel bench gmsh3d`, `step42-accuracy`; another mesh)",
     "optimize": "3D: gmsh's Netgen optimization of the tetrahedra (false: meshing about 6x faster, the worst "
                 "element about half as good; another mesh, so other results at the discretization level)",
 }
@@ -112,7 +115,8 @@ def keyword_rows() -> list[tuple[str, str, str, str]]:
     for name, items in sorted(by_name.items()):
         f = items[0][1]
         ann = typing.get_args(f.annotation)[0] if typing.get_origin(f.annotation) is Annotated else f.annotation
-        typ = "table, optional" if name == "refine" else str(ann) if "[" in str(ann) else ann.__name__
+        typ = ("table, optional" if name == "refine" else "str, one of " + ", ".join(typing.get_args(ann))
+               if typing.get_origin(ann) is Literal else str(ann) if "[" in str(ann) else ann.__name__)
         defaults = "; ".join(f"{b}: {'required' if g.is_required() else repr(g.default)}" for b, g in items)
         rows.append((f"geometry.{name}", typ, defaults,
                      f"{HELP.get(name, 'a keyword of the builder')} (builders: {', '.join(b for b, _ in items)})"))

@@ -125,12 +125,18 @@ def test_the_mesh_cache_option_of_wendel_run(tmp_path, monkeypatch, capsys):
     assert hits == [False, True] and len(_entries(tmp_path / "cache")) == 1
 
 
-def test_box_without_netgen_is_another_valid_mesh_under_another_key(tmp_path, monkeypatch):
-    """geometry.optimize = false (box): gmsh's tetrahedra without the Netgen optimization: the same boundaries,
-    another mesh (so another cache key), every tetrahedron of positive volume."""
+@pytest.mark.parametrize("variant", [{"optimize": False}, {"optimize": False, "algorithm": "hxt"},
+                                     {"algorithm": "hxt"}])
+def test_box_without_netgen_is_another_valid_mesh_under_another_key(variant, tmp_path, monkeypatch):
+    """geometry.optimize = false and/or algorithm = "hxt" (box): gmsh's tetrahedra without the Netgen
+    optimization, or by HXT instead of Delaunay: the same boundaries, another mesh (so another cache key),
+    every tetrahedron of positive volume; the same keywords give the same file again (HXT on one thread)."""
     monkeypatch.setenv(ENV, str(tmp_path / "cache"))
     opt = build("box", tmp_path / "opt.msh", **BOX)
-    raw = build("box", tmp_path / "raw.msh", **BOX, optimize=False)
+    raw = build("box", tmp_path / "raw.msh", **BOX, **variant)
+    monkeypatch.delenv(ENV)
+    again = build("box", tmp_path / "again.msh", **BOX, **variant)
+    assert (tmp_path / "again.msh").read_bytes() == (tmp_path / "raw.msh").read_bytes() and again.cache is None
     assert raw.boundaries == opt.boundaries and raw.dimension == 3 and raw.elements > 0
     assert raw.cache["key"] != opt.cache["key"]
     assert (tmp_path / "raw.msh").read_bytes() != (tmp_path / "opt.msh").read_bytes()

@@ -55,6 +55,15 @@ def test_check_refuses_with_file_and_key(change, key, words, scene_file, capsys)
     assert words in err, err
 
 
+def test_the_3d_mesh_algorithm_is_a_name_from_a_list(scene_file, capsys):
+    """geometry.algorithm (box): "delaunay" or "hxt", refused otherwise with the key and the two names."""
+    text = edit((WORKFLOWS / "ball-indent.toml").read_text(), 'builder = "box"', 'builder = "box"\nalgorithm = "tetgen"')
+    path = scene_file(text)
+    assert main(["check", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert f"{path}: geometry.algorithm" in err and "'delaunay' or 'hxt'" in err, err
+
+
 def test_ring_radii_must_be_ordered(scene_file, capsys):
     text = edit((WORKFLOWS / "cylinder.toml").read_text(), "r_inner = 1.0", "r_inner = 2.0")
     path = scene_file(text)
