@@ -7,6 +7,7 @@ import json
 import resource
 import subprocess
 import sys
+from pathlib import Path
 
 import meshio
 import numpy as np
@@ -38,6 +39,24 @@ def test_check_and_keys_import_nothing_heavy_and_take_little_cpu():
         after = resource.getrusage(resource.RUSAGE_CHILDREN)
         cpu.append(after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime)
     assert min(cpu) < 0.5, cpu
+
+
+def test_the_console_script_leaves_with_its_code_its_output_flushed_and_its_atexit_functions_run(tmp_path):
+    """wendel.cli.leave (the end of the ``wendel`` console script, without the interpreter's teardown): the
+    exit code, unflushed output on both streams and the atexit functions survive it; the console script
+    itself passes main's code through (2 for a bad scene)."""
+    mark = tmp_path / "atexit"
+    code = ("import atexit, sys\nfrom wendel.cli import leave\n"
+            f"atexit.register(lambda: open({str(mark)!r}, 'w').write('ran'))\n"
+            "sys.stdout.write('out'); sys.stderr.write('err')\nleave(3)\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert (out.returncode, out.stdout, out.stderr) == (3, "out", "err")
+    assert mark.read_text() == "ran"
+    bad = tmp_path / "bad.toml"
+    bad.write_text("x = 1\n")
+    script = Path(sys.executable).with_name("wendel")
+    out = subprocess.run([str(script), "check", str(bad)], capture_output=True, text=True)
+    assert out.returncode == 2 and "x: unknown key" in out.stderr
 
 
 def _not_blank(png) -> None:

@@ -215,5 +215,27 @@ def _print_summary(root: Path) -> None:
     print(f"results: {root}  (ParaView: {root / 'results.pvd'})")
 
 
+def leave(code: int | None) -> None:
+    """End the process with ``code`` without the interpreter's teardown of its 500-odd modules (issue 20:
+    0.09-0.13 s after a smoke run's last file, measured with ``os._exit`` against ``sys.exit``). Only after
+    ``main`` returned: every thread is joined and every file closed by then; the atexit functions still run
+    and the standard streams are flushed."""
+    import atexit
+
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError):
+            pass
+    atexit._run_exitfuncs()
+    os._exit(code or 0)
+
+
+def entry() -> None:
+    """The ``wendel`` console script: :func:`main`, then :func:`leave` (an error that escapes ``main``, and
+    ``SystemExit`` from argparse, end the process the usual way)."""
+    leave(main())
+
+
 if __name__ == "__main__":
-    sys.exit(main())
+    entry()

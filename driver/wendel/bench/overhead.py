@@ -49,6 +49,11 @@ if tree:
 from wendel.loop import run
 run(scene, smoke=smoke == "1", out=Path(out), progress=lambda *a: None,
     scale=float(scale) if scale else None)
+try:                                      # the end of the wendel console script (a checkout that has it)
+    from wendel.cli import leave
+except ImportError:
+    leave = sys.exit
+leave(0)
 """
 
 
