@@ -41,9 +41,9 @@
 //   a displacement system of that size is taken as this rank's part: K holds the sum over this rank's
 //   elements only (the whole matrix is the sum of the ranks' parts; fixed rows need not be set), b the whole
 //   right-hand side (the same on every rank) and fix is required. Each rank gives its entries in PETSc's
-//   coordinate format (MatSetPreallocationCOO once per pattern, the entries sorted in PETSc's row and column
-//   order first, then MatSetValuesCOO per matrix: PETSc sums the parts and moves the entries of rows owned by
-//   another rank; 14x faster than MatSetValues with ADD_VALUES row by row, measured at 17k DoFs), the fixed rows and columns become identity rows scaled by
+//   coordinate format (MatSetPreallocationCOO once per pattern, then MatSetValuesCOO per matrix: PETSc sums
+//   the parts and moves the entries of rows owned by another rank; 14x faster than MatSetValues with
+//   ADD_VALUES row by row, measured at 17k DoFs), the fixed rows and columns become identity rows scaled by
 //   the mean free diagonal of the sum, as on one rank. Size 0 undoes it.
 //
 // State kept between calls: one cached solver (Mat, KSP, CSR pattern and the permutation from K's triplets
