@@ -82,9 +82,8 @@ struct Cache {
     bool parts = false;                        // wendelPetscLayout: K is this rank's part of the sum
     std::vector<PetscInt> gcol;                // parts: global (PETSc) column of every CSR entry
     std::vector<long> owned;                   // parts: the DoFs whose (PETSc) rows are this rank's
-    std::vector<PetscScalar> coo;              // parts: MatSetValuesCOO's values (in PETSc's order)
-    std::vector<size_t> cooSlot;               // parts: the slot in coo of every CSR entry, then of the diagonal
-                                               // of every owned row (the fixed rows' scale, else 0)
+    std::vector<PetscScalar> coo;              // parts: MatSetValuesCOO's values, the CSR entries then the
+                                               // diagonal of every owned row (the fixed rows' scale, else 0)
     bool reuse = true;
     double rateAtSetup = 0;                    // digits of residual reduction per iteration after the setup
     double setupIts = 20;                      // -wendel_pc_setup_its: a setup's cost in Krylov iterations
@@ -196,9 +195,8 @@ PetscErrorCode fillValues(const HashMatrix<int, double>& H, const KN<double>& fi
         PetscCallMPI(MPI_Allreduce(part, sum, 2, MPI_DOUBLE, MPI_SUM, PETSC_COMM_WORLD));
         if (sum[1] > 0 && sum[0] > 0) *scale = std::fabs(sum[0]) / (sum[1] / cache.size);
         cache.coo.resize(nnz + cache.owned.size());
-        for (long k = 0; k < nnz; ++k) cache.coo[cache.cooSlot[k]] = v[k];
-        for (size_t k = 0; k < cache.owned.size(); ++k)
-            cache.coo[cache.cooSlot[nnz + k]] = fix[cache.owned[k]] > 0.5 ? *scale : 0.;
+        std::copy(v.begin(), v.end(), cache.coo.begin());
+        for (size_t k = 0; k < cache.owned.size(); ++k) cache.coo[nnz + k] = fix[cache.owned[k]] > 0.5 ? *scale : 0.;
         PetscCall(MatSetValuesCOO(cache.A, cache.coo.data(), INSERT_VALUES));     // sums the parts, assembles
         PetscFunctionReturn(0);
     }
@@ -271,24 +269,7 @@ PetscErrorCode setupSolver(const KN<double>& coords, long bs)
                 cj[p] = cache.gcol[p];
             }
         for (size_t k = 0; k < cache.owned.size(); ++k) ci[nnz + k] = cj[nnz + k] = layout[cache.owned[k]];
-        // In PETSc's order, rows then columns (two stable counting sorts: by column, then by row): PETSc sorts
-        // the entries it is given, and ordered input halves its time (0.30 -> 0.14-0.16 s at 119k DoFs)
-        std::vector<size_t> count(n + 1), byCol(ncoo), order(ncoo);
-        for (size_t e = 0; e < ncoo; ++e) ++count[cj[e] + 1];
-        for (PetscInt g = 0; g < n; ++g) count[g + 1] += count[g];
-        for (size_t e = 0; e < ncoo; ++e) byCol[count[cj[e]]++] = e;
-        std::fill(count.begin(), count.end(), 0);
-        for (size_t e = 0; e < ncoo; ++e) ++count[ci[e] + 1];
-        for (PetscInt g = 0; g < n; ++g) count[g + 1] += count[g];
-        for (size_t e : byCol) order[count[ci[e]]++] = e;
-        std::vector<PetscInt> si(ncoo), sj(ncoo);
-        cache.cooSlot.resize(ncoo);
-        for (size_t q = 0; q < ncoo; ++q) {
-            si[q] = ci[order[q]];
-            sj[q] = cj[order[q]];
-            cache.cooSlot[order[q]] = q;
-        }
-        PetscCall(MatSetPreallocationCOO(cache.A, (PetscCount)ncoo, si.data(), sj.data()));
+        PetscCall(MatSetPreallocationCOO(cache.A, (PetscCount)ncoo, ci.data(), cj.data()));
     }
     else if (cache.size == 1)
         PetscCall(MatSeqAIJSetPreallocationCSR(cache.A, cache.rowptr.data(), cache.col.data(), zero.data()));
