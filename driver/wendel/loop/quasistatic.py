@@ -25,7 +25,7 @@ from ..scene import load
 from ..scene.reading import check_size
 from ..scene.schema import Scene
 from .checkpoint import RunFiles, State, committed, save as _save_checkpoint
-from . import overlap, separated
+from . import overlap, predictor, separated
 from .guard import disk_full as _disk_full, guarded
 from .resume import is_drilling, restart, resume as resume_run, resume_drilling
 from .launch import options, write_tables
@@ -191,6 +191,7 @@ def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress)
         loads = files.tables / "loads.txt"
         loads.write_text(f"{len(batch)}\n" + "".join(f"{lf!r}\n" for lf in batch))
         opts = options(seg_scene, files, dimension, seg) + extra + ["-loads", str(loads), "-inc0", str(inc0)]
+        opts += predictor.options(scene, files, state, dimension)      # the last motion, across launches
         if state.reequilibrate:
             opts += ["-restart", str(files.root / seg["state"]), "-relax_steps",
                      str(state.remeshes[-1].get("relax_steps") or scene.remesh.relax_steps)]
@@ -288,8 +289,7 @@ def accept(scene: Scene, files: RunFiles, state: State, dimension: int) -> None:
 
 
 def _new_run_dir(scene_path: Path, smoke: bool) -> Path:
-    stamp = time.strftime("%Y%m%d-%H%M%S")
-    base = RESULTS / scene_path.stem / (stamp + ("-smoke" if smoke else ""))
+    base = RESULTS / scene_path.stem / (time.strftime("%Y%m%d-%H%M%S") + ("-smoke" if smoke else ""))
     d, k = base, 1
     while True:                        # created here, atomically: parallel runs of a sweep get their own
         try:
