@@ -55,21 +55,20 @@ def test_check_refuses_with_file_and_key(change, key, words, scene_file, capsys)
     assert words in err, err
 
 
-def test_the_3d_mesh_algorithm_is_a_name_from_a_list(scene_file, capsys):
-    """geometry.algorithm (box): "delaunay" or "hxt", refused otherwise with the key and the two names."""
-    text = edit((WORKFLOWS / "ball-indent.toml").read_text(), 'builder = "box"', 'builder = "box"\nalgorithm = "tetgen"')
-    path = scene_file(text)
-    assert main(["check", str(path)]) == 2
-    err = capsys.readouterr().err
-    assert f"{path}: geometry.algorithm" in err and "'delaunay' or 'hxt'" in err, err
+OTHER_SCENES = [
+    # a 3D builder's tetrahedral algorithm: "delaunay" or "hxt" (box)
+    ("ball-indent.toml", ('builder = "box"', 'builder = "box"\nalgorithm = "tetgen"'), "geometry.algorithm",
+     "'delaunay' or 'hxt'"),
+    ("cylinder.toml", ("r_inner = 1.0", "r_inner = 2.0"), "geometry.r_inner", "smaller than r_outer"),
+]
 
 
-def test_ring_radii_must_be_ordered(scene_file, capsys):
-    text = edit((WORKFLOWS / "cylinder.toml").read_text(), "r_inner = 1.0", "r_inner = 2.0")
-    path = scene_file(text)
+@pytest.mark.parametrize("scene, change, key, words", OTHER_SCENES)
+def test_check_refuses_with_file_and_key_in_other_scenes(scene, change, key, words, scene_file, capsys):
+    path = scene_file(edit((WORKFLOWS / scene).read_text(), *change))
     assert main(["check", str(path)]) == 2
     err = capsys.readouterr().err
-    assert f"{path}: geometry.r_inner" in err and "smaller than r_outer" in err, err
+    assert f"{path}: {key}" in err and words in err, err
 
 
 def test_size_guards_refuse_before_meshing(scene_file, capsys):
