@@ -26,7 +26,7 @@ from typing import Annotated, Any, Literal, Optional
 
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, ValidationError, create_model, model_validator
 
-from .builders import BUILDERS
+from .builders import ALGORITHMS_3D, BUILDERS
 
 STRICT = ConfigDict(strict=True, extra="forbid", allow_inf_nan=False)
 
@@ -80,7 +80,7 @@ KNOWN: dict[str, Any] = {
     # orthogonal-cutting
     "depth": Length, "uncut": Length, "pre_cut": Length, "band": Annotated[float, Field(gt=0)],
     "fine": Annotated[float, Field(gt=0, le=1)],
-    "algorithm": Literal["delaunay", "hxt"],
+    "algorithm": Literal[tuple(ALGORITHMS_3D)],
 }
 
 

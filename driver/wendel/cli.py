@@ -217,7 +217,7 @@ def _print_summary(root: Path) -> None:
 
 def leave(code: int | None) -> None:
     """End the process with ``code`` without the interpreter's teardown of its 500-odd modules (issue 20:
-    0.09-0.13 s after a smoke run's last file, measured with ``os._exit`` against ``sys.exit``). Only after
+    0.09-0.24 s after a smoke run's last file, measured with ``os._exit`` against ``sys.exit``). Only after
     ``main`` returned: every thread is joined and every file closed by then; the atexit functions still run
     and the standard streams are flushed."""
     import atexit
