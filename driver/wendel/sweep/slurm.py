@@ -18,17 +18,29 @@ from pathlib import Path
 
 import submitit
 
-from .folders import DONE, FAILED, STALE, execute, mark_failed, move_aside, read_json, run_dir, state, write_json
+from .folders import DONE, FAILED, INTERRUPTED, STALE, execute, mark_failed, move_aside, read_json, run_dir, state, write_json
 
 LIVE = {"PENDING", "RUNNING", "REQUEUED", "REQUEUE_HOLD", "REQUEUE_FED", "CONFIGURING", "COMPLETING", "SUSPENDED",
         "RESIZING", "SIGNALING", "STAGE_OUT", "RESV_DEL_HOLD", "STOPPED"}
+
+
+REQUEUE_WAIT = 30.0
+"""s a task whose run was killed by a signal waits for its own signal (and submitit's requeue) before it ends."""
 
 
 class RunJob(submitit.helpers.Checkpointable):
     """One run of a sweep as a SLURM task; requeued on timeout or preemption (resumes from its checkpoint)."""
 
     def __call__(self, root: str, key: str) -> dict:
-        return execute(Path(root), key, killed_is_failure=False)
+        result = execute(Path(root), key, killed_is_failure=False)
+        if result["status"] == INTERRUPTED:
+            # SLURM signals every process of the task (USR2 before a time limit or a preemption): the run's own
+            # process can die of it before this one's handler (submitit's requeue) has run; returning now would
+            # end the job as done, unrequeued (seen once in a CI run). Wait here for the signal and the requeue.
+            end = time.monotonic() + REQUEUE_WAIT
+            while time.monotonic() < end:
+                time.sleep(0.2)
+        return result
 
 
 def max_array_size() -> int:
