@@ -41,6 +41,21 @@ def test_check_and_keys_import_nothing_heavy_and_take_little_cpu():
     assert min(cpu) < 0.5, cpu
 
 
+def test_a_run_starts_its_picture_process_before_the_scene_schema_is_imported(monkeypatch):
+    """`wendel run` parses its arguments and starts its picture process (`_prestart_picture`) before pydantic
+    and the scene schema are imported (0.3-0.6 s here): the sweep package's argument builder does not pull in
+    the sweep plan."""
+    code = ("import sys\nfrom wendel import cli\n"
+            "def seen(path):\n"
+            "    print(sorted(m for m in ('pydantic', 'wendel.scene', 'wendel.sweep.plan') if m in sys.modules))\n"
+            "    raise SystemExit(0)\n"
+            "cli._prestart_picture = seen\n"
+            "cli.main(['run', sys.argv[1]])\n")
+    out = subprocess.run([sys.executable, "-c", code, str(WORKFLOWS / "smoke.toml")], capture_output=True,
+                         text=True, check=True)
+    assert out.stdout.strip() == "[]", out.stdout
+
+
 def test_the_console_script_leaves_with_its_code_its_output_flushed_and_its_atexit_functions_run(tmp_path):
     """wendel.cli.leave (the end of the ``wendel`` console script, without the interpreter's teardown): the
     exit code, unflushed output on both streams and the atexit functions survive it; the console script

@@ -13,11 +13,24 @@ import json
 import time
 from collections import Counter
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from .folders import DONE, FAILED, INTERRUPTED, PENDING, STALE, read_json, run_dir, state, write_json
-from .plan import Sweep, flatten, load_sweep
+
+if TYPE_CHECKING:
+    from .plan import Sweep
 
 __all__ = ["prepare", "run_sweep", "status", "collect", "load_sweep", "sweep_root"]
+
+
+def __getattr__(name: str):
+    """``Sweep``, ``flatten`` and ``load_sweep`` from :mod:`wendel.sweep.plan` on first use: the CLI imports this
+    package to build its argument parser for every command, and the plan pulls in pydantic and the scene schema
+    (0.3-0.6 s) that ``wendel run`` should not wait for before its picture process starts (issue 20)."""
+    if name in ("Sweep", "flatten", "load_sweep"):
+        from . import plan
+        return getattr(plan, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def sweep_root(sweep_path: Path, out: Path | None = None) -> Path:
@@ -30,6 +43,8 @@ def sweep_root(sweep_path: Path, out: Path | None = None) -> Path:
 def prepare(sweep: Sweep, root: Path) -> dict:
     """Write plan.json and each run's scene file (scenes/<key>.toml); return the plan."""
     import tomli_w
+
+    from .plan import flatten
 
     (root / "scenes").mkdir(parents=True, exist_ok=True)
     (root / "runs").mkdir(exist_ok=True)
@@ -59,6 +74,8 @@ def _root_and_plan(target: Path, out: Path | None = None) -> tuple[Path, dict]:
         if plan is None:
             raise FileNotFoundError(f"{target}: no plan.json (not a sweep folder)")
         return target.resolve(), plan
+    from .plan import load_sweep
+
     sweep = load_sweep(target)
     root = sweep_root(target, out)
     return root, prepare(sweep, root)
@@ -71,6 +88,8 @@ def run_sweep(sweep_path: Path, out: Path | None = None, executor: str = "local"
     Every planned scene is validated first (:class:`wendel.scene.SceneError` before anything runs).
     """
     t0 = time.perf_counter()
+    from .plan import load_sweep
+
     sweep = load_sweep(sweep_path)
     root = sweep_root(sweep_path, out)
     plan = prepare(sweep, root)
