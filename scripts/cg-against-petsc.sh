@@ -1,7 +1,8 @@
 #!/bin/bash
-# The scenes that use Jacobi-CG (ball-indent, hertz-3d, stamp-indent) at their default size with their cg, with
-# PETSc-ML (numerics.solver = "petsc") and, for the plastic ones, PETSc-ML with the compiled kernels
-# (numerics.assembly = "compiled"): ROUNDS interleaved rounds, one row per run (issue 19).
+# The scenes that used Jacobi-CG until session 12 (ball-indent, hertz-3d, stamp-indent) at their default size with
+# Jacobi-CG, with PETSc-ML (numerics.solver = "petsc") and, for the plastic ones, PETSc-ML with the compiled kernels
+# (numerics.assembly = "compiled", their default since session 12): ROUNDS interleaved rounds, one row per run
+# (issue 19).
 # Usage: scripts/cg-against-petsc.sh [OUT_DIR] [ROUNDS]   (run it under the heavy lock on a shared machine)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -14,7 +15,8 @@ for round in $(seq "$ROUNDS"); do
     for variant in cg petsc petsc-compiled; do
       grep -q '^\[plasticity\]' "workflows/$scene.toml" || [ "$variant" != petsc-compiled ] || continue
       f=$S/$scene-$variant.toml
-      sed "s/^solver = \"cg\".*/solver = \"${variant%%-*}\"/" "workflows/$scene.toml" > "$f"
+      # the scene's own solver and assembly lines replaced by the variant's
+      sed -e "/^assembly = /d" -e "s/^solver = .*/solver = \"${variant%%-*}\"/" "workflows/$scene.toml" > "$f"
       [ "$variant" != petsc-compiled ] || sed -i 's/^solver = "petsc"/solver = "petsc"\nassembly = "compiled"/' "$f"
       out=$S/run-$scene-$variant-$round
       rm -rf "$out"

@@ -155,7 +155,7 @@ def test_obstacle_that_never_touches_gives_the_elastic_solution(meshes, tmp_path
 
 def test_stamp_that_never_touches_an_unloaded_cube(tmp_path):
     # Nothing loads the cube and the height map stays 0.5 m above it: zero displacement, no active node,
-    # KKT numbers of 0 (not 0/0) through the step-42 entry and its CG path.
+    # KKT numbers of 0 (not 0/0) through the step-42 entry and its PETSc path with the compiled kernels.
     text = (WORKFLOWS / "stamp-indent.toml").read_text()
     assert "center = [0.5, 0.5, 1.999]" in text
     scene = tmp_path / "stamp-away.toml"

@@ -57,7 +57,7 @@ def test_keeping_the_preconditioner_is_decided_alike_in_every_run(ball):
 def test_forcing_needs_an_iterative_solver(tmp_path):
     scene = tmp_path / "bad.toml"
     text = (WORKFLOWS / "ball-indent.toml").read_text()
-    text = text.replace('solver = "cg"', 'solver = "direct"\nforcing = "ew"', 1)
+    text = text.replace('solver = "petsc"', 'solver = "direct"\nforcing = "ew"', 1)
     scene.write_text(text)
     r = subprocess.run([sys.executable, "-m", "wendel.cli", "check", str(scene)], capture_output=True, text=True)
     assert r.returncode == 2

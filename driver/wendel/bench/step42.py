@@ -43,6 +43,7 @@ def _run_measured(scene: Path, out: Path, h: float | None = None, solver: str | 
             "scene = load(scene_path, smoke=smoke)\n"
             "if h != '-': scene.geometry.h = float(h)\n"
             "if solver != '-': scene.numerics.solver = solver\n"
+            "scene.numerics.assembly = 'freefem'\n"     # the FreeFEM-language path this bench has always measured
             "scene.numerics.ranks = ranks\n"
             "scene.output.png = False\n"
             "run_scene(scene, scene_path, out, progress=lambda *_: None)\n"
