@@ -204,6 +204,10 @@ def test_hertz_3d_at_a_prescribed_force_in_one_run(tmp_path):
     assert all(last[k] < 1e-8 for k in KKT)
     assert last["contact_active_nodes"] > 100
     assert -0.0095 < last["tool_position"] < -0.0085               # m (measured -8.90 mm; a half-space: a^2 / R = -10.2 mm)
+    # Each Newton step solves for the tool's position with two right-hand sides on one factorization and hands
+    # the combination to the loop's own solve (solver.idp, solverPresolve): two direct solves per step, not three
+    # (the loop's solve is not counted again: it returns the combination without solving)
+    assert last["linear_iterations"] == 2 * last["newton_iterations"]
 
 
 def test_scratch_large_sliding_of_a_rounded_wedge(tmp_path):
