@@ -293,6 +293,35 @@ def test_restarts_between_increments_keep_the_friction_state(tmp_path):
         assert b[key] == pytest.approx(a[key], rel=1e-10), key
 
 
+def test_friction_trace_records_the_sets_of_every_newton_iteration(tmp_path):
+    # contact.friction.trace: one row per node in contact (in the last solve or now) at every Newton iteration;
+    # the last iteration of each increment has the converged sets (set_solved == set_now) and as many stick and
+    # slip rows as record.json counts; the sliding block's press starts every node inactive (set_solved 0) and
+    # its first slip increment changes sets on the way (the rows that tell a stagnating Newton's chattering nodes).
+    scene = variant(tmp_path, "sliding-block", {'mu = 0.3 }': 'mu = 0.3, trace = true }'})
+    root = run(scene, out=tmp_path / "sb", png=False, progress=lambda *_: None)
+    recs = records(root)
+    with open(root / "fem" / "friction-trace.csv") as f:
+        rows = list(csv.DictReader(f))
+    assert rows and {"node", "set_solved", "set_now", "gap", "lambda_n", "lambda_t", "slip", "res_0"} <= set(rows[0])
+    by_inc: dict[int, list[dict]] = {}
+    for r in rows:
+        by_inc.setdefault(int(r["increment"]), []).append(r)
+    assert sorted(by_inc) == [r["increment"] for r in recs]
+    changed = 0
+    for rec in recs:
+        inc = by_inc[rec["increment"]]
+        last = max(int(r["iteration"]) for r in inc)
+        assert last == rec["newton_iterations"]
+        final = [r for r in inc if int(r["iteration"]) == last]
+        assert all(float(r["set_solved"]) == float(r["set_now"]) for r in final)
+        assert sum(float(r["set_now"]) == 1 for r in final) == rec["friction_stick_nodes"]
+        assert sum(float(r["set_now"]) >= 2 for r in final) == rec["friction_slip_nodes"]
+        changed += sum(float(r["set_solved"]) != float(r["set_now"]) for r in inc)
+    assert all(float(r["set_solved"]) == 0 for r in by_inc[recs[0]["increment"]] if r["iteration"] == "0")
+    assert changed > 0
+
+
 def test_bad_friction_input_is_named(tmp_path):
     from wendel.scene import load
 

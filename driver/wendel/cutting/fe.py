@@ -121,7 +121,7 @@ def fe_scene(scene, travel: float = 1.0) -> Scene:
                   "jc_C": p.jc_C, "jc_rate0": p.jc_rate0, "jc_m": p.jc_m, "jc_T_room": p.jc_T_room,
                   "jc_T_melt": p.jc_T_melt, "load_time": cut / MM / c.speed}
     friction = {"law": "coulomb", "mu": c.friction, "frame": c.friction_frame,
-                "residual": c.friction_residual}
+                "residual": c.friction_residual, "trace": c.friction_trace}
     if c.shear_cap is not None:
         friction["tau_max"] = c.shear_cap * MPA
     steps = scene.loading.steps

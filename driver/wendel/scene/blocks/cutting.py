@@ -72,6 +72,9 @@ class Cutting(BaseModel):
     friction_residual: Literal["compiled", "freefem", "check"] = Field(
         "compiled", description="FE: the pass over the contact nodes at each residual (tool distance, sets, rows, "
         "masses), as contact.friction.residual (compiled, freefem or check)")
+    friction_trace: bool = Field(False, description="FE: write every contact node's sets, gap, pressure, "
+                                 "traction and slip at every Newton iteration to fem/friction-trace.csv, as "
+                                 "contact.friction.trace (failed increments included)")
     properties_T0: float = Field(273.15, gt=0, description="temperature at which thermal.k and thermal.c hold [K]")
     k_slope: float = Field(0.0, description="dk/dT of the work material [W/m/K^2]")
     c_slope: float = Field(0.0, description="dc/dT of the work material [J/kg/K^2]")

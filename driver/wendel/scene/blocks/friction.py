@@ -51,6 +51,9 @@ class Friction(BaseModel):
                                            "language's loop, slower) or check (both; goes on with the compiled one "
                                            "and records friction_residual_diff, their largest relative difference); "
                                            "the same numbers")
+    trace: bool = Field(False, description="write every contact node's sets (of the last solve and of the current "
+                        "state), gap, pressure, traction and slip at every Newton iteration to fem/friction-trace.csv "
+                        "(failed increments included: which nodes change their sets while Newton stagnates)")
 
     @model_validator(mode="after")
     def _law(self):
@@ -143,6 +146,8 @@ def friction_options(block, files) -> list[str]:
     opts = ["-fric_law", str(FRICTION_LAWS[f.law]), "-fric_mu", repr(f.mu),
             "-fric_tau", repr(f.tau_max or 0.0), "-fric_c", repr(f.c), "-fric_heat_fraction", repr(f.heat_fraction),
             "-fric_frame", str(FRICTION_PASSES[f.frame]), "-fric_residual", str(FRICTION_PASSES[f.residual])]
+    if f.trace:
+        opts += ["-fric_trace", "1"]
     if block.force is not None:
         opts += ["-tool_force", repr(block.force), "-tool_force_tol", repr(block.force_tol)]
     if files is None:
