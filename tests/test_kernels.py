@@ -150,3 +150,42 @@ def test_compiled_assembly_refused_where_it_does_not_apply(tmp_path, scene, extr
     assert r.returncode == 2
     assert "numerics.assembly" in r.stderr and why in r.stderr and "bad.toml" in r.stderr
     assert "Traceback" not in r.stderr
+
+
+PART_PROBE = """load "msh3"
+load "wendel_kernels"
+mesh3 Th = cube(9, 6, 5, [2 * x, y, z]);      // longest side along x
+real[int] order(1);
+int nt = Th.nt;
+int[int] mine(3);
+for (int r = 0; r < 3; ++r) mine[r] = wendelPart3(Th, r, 3, order);
+cout << "nv " << Th.nv << " nt " << nt << " tets " << mine[0] << " " << mine[1] << " " << mine[2] << endl;
+ofstream f("{out}");
+for (int a = 0; a < Th.nv; ++a) f << Th(a).x << " " << order[3 * a] << " " << order[3 * a + 1] << " " << order[3 * a + 2] << endl;
+"""
+
+
+def test_partition_slabs_keep_the_mesh_numbering(tmp_path):
+    """wendelPart3 on 3 ranks: one slab of equal vertex count per rank along the longest side, each rank's PETSc
+    rows a contiguous block of whole vertices, within a slab the mesh's vertex numbering (the locality of one
+    rank's rows, not the coordinate order), and every tetrahedron on exactly one rank."""
+    from wendel import freefem
+    script, out = tmp_path / "part.edp", tmp_path / "order.txt"
+    script.write_text(PART_PROBE.replace("{out}", str(out)))
+    p = subprocess.run(["FreeFem++-mpi", "-nw", "-v", "0", str(script)], env=freefem.environment(),
+                       capture_output=True, text=True, timeout=120)
+    assert p.returncode == 0, p.stdout + p.stderr
+    words = next(line for line in p.stdout.splitlines() if line.startswith("nv ")).split()
+    nv, nt, tets = int(words[1]), int(words[3]), [int(w) for w in words[5:8]]
+    assert sum(tets) == nt and min(tets) > 0
+    a = np.loadtxt(out)
+    x, order = a[:, 0], a[:, 1:].astype(int)
+    assert (order[:, 1] == order[:, 0] + 1).all() and (order[:, 2] == order[:, 0] + 2).all()
+    pos = order[:, 0] // 3
+    assert sorted(pos) == list(range(nv))                  # a permutation of whole vertices
+    for r in range(3):
+        slab = np.flatnonzero((pos >= nv * r // 3) & (pos < nv * (r + 1) // 3))     # rank r's rows
+        assert (np.diff(pos[slab]) == 1).all()          # in the mesh's numbering: vertex order = row order
+        if r < 2:
+            nxt = np.flatnonzero((pos >= nv * (r + 1) // 3) & (pos < nv * (r + 2) // 3))
+            assert x[slab].max() <= x[nxt].min()        # slabs along x

@@ -59,6 +59,27 @@ def test_petsc_two_ranks(tmp_path, ball_direct):
     assert p["newton_iterations"] == ball_direct["newton_iterations"]
 
 
+def test_ml_keeps_its_interpolation_on_two_ranks_only(tmp_path, ball_direct):
+    """ML's preset on 2+ ranks keeps the aggregation and interpolation of its first setup at a new setup (fewer
+    Krylov iterations there, README "2 ranks"); one rank keeps the plain preset, whose iterates it would move;
+    the user's options still override it. Every variant gives the direct solver's iterates."""
+    runs = {"np1": solve("ball-indent", "petsc", tmp_path / "np1"),
+            "np2": solve("ball-indent", "petsc", tmp_path / "np2", ranks=2),
+            "np2-off": solve("ball-indent", "petsc", tmp_path / "np2-off", ranks=2,
+                             options="-pc_ml_reuse_interpolation false")}
+    ld = ball_direct["last_increment"]
+    for name, s in runs.items():
+        lp = s["last_increment"]
+        assert lp["contact_force"] == pytest.approx(ld["contact_force"], rel=1e-7), name
+        assert s["newton_iterations"] == ball_direct["newton_iterations"], name
+        assert lp["petsc_setups"] >= 1, name
+    opts = {name: s["last_increment"]["petsc_options"].split() for name, s in runs.items()}
+    assert "-pc_ml_reuse_interpolation" not in opts["np1"]
+    i = opts["np2"].index("-pc_ml_reuse_interpolation")
+    assert opts["np2"][i + 1] == "true"
+    assert opts["np2-off"][-2:] == ["-pc_ml_reuse_interpolation", "false"]     # after the preset: PETSc takes the last
+
+
 def test_petsc_prescribed_displacement(tmp_path):
     """Non-zero Dirichlet values enter the first Newton step: lifted, not put on tgv rows."""
     d = solve("uniaxial-linear", "direct", tmp_path / "direct")

@@ -21,7 +21,9 @@
 //       Rank-local assembly on `size` MPI ranks: the vertices sorted along the axis of the bounding box's
 //       largest extent are cut into `size` slabs of equal vertex counts; `order` (resized to 3 nv) gets the
 //       global (PETSc) index of every DoF, 3 (slab-ordered vertex) + component, so that rank r's rows are the
-//       r-th contiguous block; a tetrahedron belongs to the rank owning its lowest-ordered vertex. From then on
+//       r-th contiguous block, and within a slab the vertices keep the mesh's numbering (not the coordinate
+//       order: the rows keep the locality of the mesh's numbering, as on one rank); a tetrahedron belongs to
+//       the rank of the lowest slab among its vertices. From then on
 //       wendelTangent3 and wendelInternal3 sum over this rank's tetrahedra only (K and f are this rank's
 //       parts: the sum over the ranks is the whole), and wendelTangent3 leaves the fixed rows to the solver
 //       (no 1 on their diagonal). size 1 undoes it. Returns the number of this rank's tetrahedra.
@@ -270,6 +272,21 @@ long wendelPart3(const Mesh3* const& pTh, const long& rank, const long& size, KN
     std::stable_sort(byPos.begin(), byPos.end(), [&coord](long a, long b) { return coord(a) < coord(b); });
     std::vector<long> pos(nv);
     for (long p = 0; p < nv; ++p) pos[byPos[p]] = p;
+    // The slab of a vertex is its block of sorted positions; within its slab a vertex keeps the mesh's
+    // numbering (its rank among the slab's vertices by vertex number), not the coordinate order: the rows
+    // of a rank keep the locality of the mesh's numbering, as on one rank.
+    {
+        std::vector<long> next(size);
+        for (long r = 0; r < size; ++r) next[r] = nv * r / size;
+        std::vector<long> inSlab(nv);
+        for (long a = 0; a < nv; ++a) {
+            long r = std::min(size - 1, pos[a] * size / nv);       // the slab: nv r / size <= pos < nv (r + 1) / size
+            while (r > 0 && pos[a] < nv * r / size) --r;
+            while (r + 1 < size && pos[a] >= nv * (r + 1) / size) ++r;
+            inSlab[a] = next[r]++;
+        }
+        pos.swap(inSlab);
+    }
     for (long a = 0; a < nv; ++a)
         for (int d = 0; d < 3; ++d) (*order)[3 * a + d] = 3 * pos[a] + d;
     const long start = nv * rank / size, end = nv * (rank + 1) / size;   // the petsc plugin's row blocks
