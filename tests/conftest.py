@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import signal
 from pathlib import Path
 
 import pytest
@@ -114,3 +115,10 @@ def drill(tmp_path, template: str, extra: str, name: str):
     scene.write_text(template.format(extra=extra))
     root = run(scene, out=tmp_path / name, progress=lambda *_: None)
     return root, json.loads((root / "summary.json").read_text())["drilling"]
+
+
+def default_sigint():
+    """For ``preexec_fn``: a child started with SIGINT at its default, which Python turns into KeyboardInterrupt.
+    A suite started in the background of a non-interactive shell (``cmd &``) inherits SIGINT ignored, and so
+    would the runs and sweeps the tests stop with SIGINT (they would finish unstopped)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)

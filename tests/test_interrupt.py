@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import WORKFLOWS
+from conftest import WORKFLOWS, default_sigint
 
 SCENE = WORKFLOWS / "upsetting.toml"
 FIELDS = ("strain_energy", "max_plastic_strain", "max_displacement", "max_von_mises", "plastic_volume")
@@ -26,7 +26,7 @@ FIELDS = ("strain_energy", "max_plastic_strain", "max_displacement", "max_von_mi
 
 def _start(*args: str) -> subprocess.Popen:
     return subprocess.Popen([sys.executable, "-m", "wendel.cli", "run", *args], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)
+                            stderr=subprocess.PIPE, text=True, preexec_fn=default_sigint)
 
 
 def fingerprints(run: Path) -> dict:

@@ -12,6 +12,7 @@ import time
 from pathlib import Path
 
 import pytest
+from conftest import default_sigint
 
 from wendel.scene import SceneError
 from wendel.sweep import load_sweep, run_sweep, status
@@ -96,7 +97,8 @@ def test_ctrl_c_leaves_a_resumable_sweep(tmp_path):
     sweep = sweep_file(tmp_path, '[grid]\n"material.E" = [1.0, 2.0]\n"loading.steps" = [20]   # 1\n')
     out = tmp_path / "out"
     proc = subprocess.Popen([sys.executable, "-m", "wendel.cli", "sweep", str(sweep), "--out", str(out),
-                             "--workers", "2", "--quiet"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                             "--workers", "2", "--quiet"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=default_sigint)
     keys = [r.key for r in load_sweep(sweep).runs]
     deadline = time.time() + 90
     while time.time() < deadline:      # wait until both runs have committed increments

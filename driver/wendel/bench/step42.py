@@ -5,7 +5,9 @@ the contact, h/8 in the contact zone) and workflows/stamp-indent.toml once, each
 process so that its peak memory is measured; rows give DoFs, Newton and linear iterations, the step-42
 fingerprints, wall time by phase (assembly, constitutive update, linear solve, active-set update, output)
 and peak memory per DoF. Then the strong-scaling pair (ffddm on 1 and 2 ranks) at one size. It writes
-``step42_force_vs_time.png``: contact force against wall time, next to deal.II's figures.
+``step42_force_vs_time.png``: contact force against wall time, next to deal.II's figures. Last, when deal.II's
+step-42 is installed (``make dealii``), deal.II and wendel's default path run interleaved in the same bench run
+(the rows of ``step42-pair``: per Newton step per DoF and whole-run wall times with their ratios).
 
 ``step42-dealii`` builds and runs deal.II's own step-42 (Debian's ``libdeal.ii-dev`` and ``libdeal.ii-doc``,
 ``apt-get install libdeal.ii-dev libdeal.ii-doc cmake``) on this machine: Q1, one MPI rank, global
@@ -77,7 +79,8 @@ def _row(case: str, s: dict) -> dict:
 
 @register("step42")
 def step42(quick: bool, workdir: Path) -> list[dict]:
-    """Ball over graded meshes (direct and CG), the stamp, ffddm on 1 and 2 ranks; force-vs-time plot."""
+    """Ball over graded meshes (direct and CG), the stamp, ffddm on 1 and 2 ranks; force-vs-time plot; then deal.II
+    and wendel's default path interleaved (step42-pair's rows) when deal.II is installed."""
     ball, stamp = WORKFLOWS / "ball-indent.toml", WORKFLOWS / "stamp-indent.toml"
     sizes = [0.2, 0.1] if quick else [0.2, 0.1, 0.07, 0.05, 0.04]
     rows = []
@@ -91,6 +94,16 @@ def step42(quick: bool, workdir: Path) -> list[dict]:
         rows.append(_row(f"ball h={h_par:g}", _run_measured(ball, workdir / f"ball-h{h_par:g}-ffddm-np{ranks}",
                                                              h=h_par, solver="ffddm", ranks=ranks)))
     plot_force_vs_time(workdir.parent.parent / "step42_force_vs_time.png", rows)
+    # deal.II's step-42 and wendel's default path (PETSc-ML, compiled kernels), interleaved, with their ratios per
+    # Newton step per DoF and of the whole run: the rows of `wendel bench step42-pair`, when deal.II is installed
+    # (`make dealii`); otherwise a row that says how to get them
+    if (DEALII_EXAMPLE / "step-42.cc").is_file():
+        from .step42_pair import step42_pair
+
+        pair = workdir.parent / "step42-pair"        # the same folder (and deal.II build) as `wendel bench step42-pair`
+        rows += [{"case": "pair: " + r.pop("code"), **r} for r in step42_pair(quick, pair)]
+    else:
+        rows.append({"case": "pair with deal.II: not run (`make dealii` installs deal.II's step-42)"})
     return rows
 
 
