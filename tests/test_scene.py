@@ -107,11 +107,12 @@ def test_bad_physics_block_is_rejected_with_file_and_key(scene_file, scene, chan
 
 
 def test_values_reach_freefem_as_numbers_only(tmp_path):
-    """A scene string never reaches FreeFEM as code: every option value is a number, a validated name or a
-    path the driver wrote."""
+    """A scene string never reaches FreeFEM as code: every option value is a number, a validated name (a solver,
+    a PETSc preconditioner preset), a path the driver wrote, or the PETSc options string that passed its check."""
     from conftest import WORKFLOWS
     from wendel.loop import RunFiles, options
     from wendel.cutting.fe import fe_scene
+    from wendel.scene.petsc import PRECONDITIONERS, check_options
     from wendel.scene.schema import SOLVERS
 
     for path in sorted(WORKFLOWS.glob("*.toml")):
@@ -125,7 +126,10 @@ def test_values_reach_freefem_as_numbers_only(tmp_path):
             assert key.startswith("-"), (path.name, key)
             if value.startswith(str(tmp_path)) or value.startswith("/"):
                 continue
+            if key == "-petsc_options":     # one string for PETSc's option parser, never FreeFEM code
+                assert check_options(value) == value, (path.name, key, value)
+                continue
             try:
                 float(value)
             except ValueError:
-                assert value in SOLVERS, (path.name, key, value)
+                assert value in {*SOLVERS, *PRECONDITIONERS}, (path.name, key, value)

@@ -40,7 +40,7 @@ def macros(scene: Scene, dimension: int) -> list[str]:
     >>> macros(load(ROOT / "workflows" / "smoke.toml"), 2)
     ['-Ddimension=2', '-DPk=P1']
     >>> macros(load(ROOT / "workflows" / "ball-indent.toml"), 3)
-    ['-Ddimension=3', '-DPk=P1', '-DWITHCONTACT=1', '-DWITHPLASTICITY=1']
+    ['-Ddimension=3', '-DPk=P1', '-DWITHCONTACT=1', '-DWITHPLASTICITY=1', '-DWITHPETSC=1', '-DWITHKERNELS=1']
     >>> macros(load(ROOT / "workflows" / "sliding-block.toml"), 2)[-1]
     '-DWITHFRICTION=1'
     """
