@@ -270,23 +270,15 @@ long wendelPart3(const Mesh3* const& pTh, const long& rank, const long& size, KN
     for (long a = 0; a < nv; ++a) byPos[a] = a;
     auto coord = [&Th, axis](long a) { const R3& P = Th.vertices[a]; return axis == 0 ? P.x : axis == 1 ? P.y : P.z; };
     std::stable_sort(byPos.begin(), byPos.end(), [&coord](long a, long b) { return coord(a) < coord(b); });
-    std::vector<long> pos(nv);
-    for (long p = 0; p < nv; ++p) pos[byPos[p]] = p;
-    // The slab of a vertex is its block of sorted positions; within its slab a vertex keeps the mesh's
-    // numbering (its rank among the slab's vertices by vertex number), not the coordinate order: the rows
-    // of a rank keep the locality of the mesh's numbering, as on one rank.
-    {
-        std::vector<long> next(size);
-        for (long r = 0; r < size; ++r) next[r] = nv * r / size;
-        std::vector<long> inSlab(nv);
-        for (long a = 0; a < nv; ++a) {
-            long r = std::min(size - 1, pos[a] * size / nv);       // the slab: nv r / size <= pos < nv (r + 1) / size
-            while (r > 0 && pos[a] < nv * r / size) --r;
-            while (r + 1 < size && pos[a] >= nv * (r + 1) / size) ++r;
-            inSlab[a] = next[r]++;
-        }
-        pos.swap(inSlab);
+    // The slab of a vertex is its block of sorted positions, nv r / size <= p < nv (r + 1) / size; within its
+    // slab a vertex keeps the mesh's numbering (its rank among the slab's vertices by vertex number), not the
+    // coordinate order: the rows of a rank keep the locality of the mesh's numbering, as on one rank.
+    std::vector<long> slab(nv), next(size), pos(nv);
+    for (long r = 0; r < size; ++r) {
+        next[r] = nv * r / size;
+        for (long p = nv * r / size; p < nv * (r + 1) / size; ++p) slab[byPos[p]] = r;
     }
+    for (long a = 0; a < nv; ++a) pos[a] = next[slab[a]]++;
     for (long a = 0; a < nv; ++a)
         for (int d = 0; d < 3; ++d) (*order)[3 * a + d] = 3 * pos[a] + d;
     const long start = nv * rank / size, end = nv * (rank + 1) / size;   // the petsc plugin's row blocks
