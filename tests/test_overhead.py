@@ -262,18 +262,25 @@ def test_the_run_takes_the_picture_process_started_before_its_mesh():
     assert other is not early and not pictures._EARLY and early.proc.poll() is not None
 
 
-@pytest.mark.parametrize("scene", ["smoke", "hertz-3d", "thermo-constrained"])
+@pytest.mark.parametrize("scene", ["smoke", "hertz-3d", "drilling-3d"])
 def test_elastic_strain_energy_on_one_point_is_the_integral_of_its_cell_fields(scene, tmp_path):
     """Elastic P1 (2D plane strain, 3D, 3D with a thermal stress): the record's strain energy (FreeFEM's
     one-point rule since issue 20) equals 0.5 sum over cells |K| sigma : eps, computed here from the VTU's
-    cell strains, E and nu (and alpha, the temperature at the cell's centroid)."""
+    cell strains, E and nu (and alpha, the temperature at the cell's centroid). (The thermal case was the
+    fully constrained cube until session 13: no strain, so both sides were round-off and the test's sign
+    check passed by chance; the drilled part under the drill's thrust and torque is the case now.)"""
     from wendel.loop import run
 
     root = run(WORKFLOWS / f"{scene}.toml", smoke=True, out=tmp_path / scene, progress=lambda *a: None)
     mat = json.loads((root / "scene.resolved.json").read_text())["material"]
     lam = mat["E"] * mat["nu"] / ((1 + mat["nu"]) * (1 - 2 * mat["nu"]))
     mu = mat["E"] / (2 * (1 + mat["nu"]))
-    m = meshio.read(sorted((root / "vtu").glob("inc-*.vtu"))[-1])
+    # the increment of the largest |energy| (the drilled part's cooling, a thermal load alone, has none:
+    # the integral of sigma : eps is the work of the loads)
+    records = {r.parent.name: json.loads(r.read_text()) for r in sorted((root / "fem").glob("inc-*/record.json"))}
+    inc = max(records, key=lambda k: abs(records[k]["strain_energy"]))
+    record = records[inc]
+    m = meshio.read(root / "vtu" / f"{inc}.vtu")
     kind = "tetra" if any(b.type == "tetra" for b in m.cells) else "triangle"
     cells = np.concatenate([b.data for b in m.cells if b.type == kind])
     x = m.points[cells]
@@ -292,8 +299,7 @@ def test_elastic_strain_energy_on_one_point_is_the_integral_of_its_cell_fields(s
         t_centroid = np.asarray(m.point_data["T"])[cells].mean(axis=1)
         density = density - 3 * (lam + 2 * mu / 3) * thermal["alpha"] * (t_centroid - thermal["T_ref"]) * trace
     energy = 0.5 * (vol * density).sum()
-    record = json.loads(sorted((root / "fem").glob("inc-*/record.json"))[-1].read_text())
-    assert energy > 0
+    assert abs(energy) > 1e-6 * 0.5 * (vol * abs(density)).sum()
     assert record["strain_energy"] == pytest.approx(energy, rel=1e-10)
 
 
