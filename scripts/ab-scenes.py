@@ -12,7 +12,9 @@ prints the run's wall time and its assembly, linear solve and constitutive updat
 for every scene, the first round's two histories (history.csv) are compared column by column: the largest
 difference over the increments relative to the column's largest magnitude over the run (so that a quantity
 that is zero up to round-off, such as the heat through an insulated face, is not read as a relative change),
-clocks, residuals and linear iterations aside, and whether the Newton counts are the same.
+clocks, residuals and linear iterations aside (the three largest, each with its column's magnitude: a column that
+is round-off over the whole run shows as a large relative difference of a tiny magnitude), and whether the
+Newton counts are the same. ROUNDS = 0 only compares the runs already in OUT_DIR.
 """
 from __future__ import annotations
 
@@ -39,12 +41,13 @@ def run(tree: Path | None, scene: str, out: Path) -> dict:
     return json.loads((out / "summary.json").read_text())
 
 
-def largest_difference(a: Path, b: Path) -> tuple[float, str, bool]:
-    """The largest difference between two runs' histories (see the module's text); whether Newton agrees."""
+def largest_differences(a: Path, b: Path, n: int = 3) -> tuple[list[tuple[float, str, float]], bool]:
+    """The n largest differences between two runs' histories, each relative to its column's largest magnitude
+    over both runs, with that magnitude (see the module's text); whether the Newton counts agree."""
     ha, hb = (list(csv.DictReader(open(r / "history.csv"))) for r in (a, b))
     if len(ha) != len(hb):
-        return float("inf"), f"{len(ha)} against {len(hb)} increments", False
-    worst = (0.0, "")
+        return [(float("inf"), f"{len(ha)} against {len(hb)} increments", 0.0)], False
+    rows = []
     for k in ha[0]:
         if k.startswith("time") or k in SKIP:
             continue
@@ -53,15 +56,14 @@ def largest_difference(a: Path, b: Path) -> tuple[float, str, bool]:
         except (ValueError, KeyError):
             continue
         scale = max(max(abs(x) for x in xs + ys), 1e-300)
-        d = max(abs(x - y) for x, y in zip(xs, ys)) / scale
-        worst = max(worst, (d, k))
-    return worst[0], worst[1], [r["newton_iterations"] for r in ha] == [r["newton_iterations"] for r in hb]
+        rows.append((max(abs(x - y) for x, y in zip(xs, ys)) / scale, k, scale))
+    return sorted(rows, reverse=True)[:n], [r["newton_iterations"] for r in ha] == [r["newton_iterations"] for r in hb]
 
 
 def main(argv: list[str]) -> None:
     base, out, rounds, scenes = Path(argv[0]).resolve(), Path(argv[1]).resolve(), int(argv[2]), argv[3:]
     out.mkdir(parents=True, exist_ok=True)
-    for r in range(1, rounds + 1):
+    for r in range(1, rounds + 1):         # ROUNDS = 0: compare the runs already in OUT_DIR
         for scene in scenes:
             for name, tree in (("base", base), ("this", None)):
                 d = out / f"{scene}-{name}-{r}"
@@ -72,9 +74,9 @@ def main(argv: list[str]) -> None:
                       f"linear solve {p['linear_solve']:.2f} s, constitutive {p['constitutive']:.2f} s, "
                       f"{s['newton_iterations']} Newton, load {os.getloadavg()[0]:.1f}", flush=True)
     for scene in scenes:
-        d, k, same = largest_difference(out / f"{scene}-base-1", out / f"{scene}-this-1")
-        print(f"{scene}: largest difference {d:.1e} of the column's magnitude ({k or 'none'}), same Newton counts: {same}")
-
+        worst, same = largest_differences(out / f"{scene}-base-1", out / f"{scene}-this-1")
+        text = ", ".join(f"{k} {d:.1e} (magnitude {m:.1e})" for d, k, m in worst)
+        print(f"{scene}: same Newton counts: {same}; largest differences relative to the column's magnitude: {text}")
 
 if __name__ == "__main__":
     main(sys.argv[1:])
