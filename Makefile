@@ -13,7 +13,8 @@ SCENE ?= workflows/drilling-rz.toml   # the product's main job: a small drilling
 
 .PHONY: setup run test bench dealii clean
 setup: build/.apt-ok $(VENV)/.ok build/plugins/MUMPS_mpi.so build/plugins/wendel_petsc.so build/plugins/wendel_tool.so \
-       build/plugins/wendel_kernels.so build/plugins/wendel_io.so build/plugins/wendel_mesh.so
+       build/plugins/wendel_kernels.so build/plugins/wendel_io.so build/plugins/wendel_mesh.so \
+       build/plugins/wendel_ul.so
 	@# wendel's own bytecode, where PYTHONDONTWRITEBYTECODE=1 would compile it at every start (issue 20)
 	@$(VENV)/bin/python -m compileall -q driver/wendel meshes > /dev/null
 
@@ -45,6 +46,11 @@ build/plugins/wendel_petsc.so: edp/plugins/wendel_petsc.cpp build/.apt-ok
 
 # wendel's compiled element kernels (lib/kernels.idp, numerics.assembly = "compiled"): no library beyond FreeFEM.
 build/plugins/wendel_kernels.so: edp/plugins/wendel_kernels.cpp build/.apt-ok
+	@mkdir -p build/plugins
+	g++ -shared -fPIC -O2 -Wall -Wno-unused-variable -Wno-sign-compare -Wno-mismatched-new-delete -isystem /usr/include/freefem++ $< -o $@
+
+# wendel's compiled per-cell kernels of the updated-Lagrangian kinematics (lib/kinematics.idp, kinematics-3d.idp).
+build/plugins/wendel_ul.so: edp/plugins/wendel_ul.cpp build/.apt-ok
 	@mkdir -p build/plugins
 	g++ -shared -fPIC -O2 -Wall -Wno-unused-variable -Wno-sign-compare -Wno-mismatched-new-delete -isystem /usr/include/freefem++ $< -o $@
 
