@@ -329,7 +329,10 @@ class Process:
         if k < len(self.steps) and self.steps[k].depth != (self.steps[k - 1].depth if k else self.depth_prev):
             kind, kwargs = self.body(self.steps[k].depth)
             self.builder.submit(kind, files.root / f"meshes/step-{k + 1:03d}.msh", kwargs)
-        if self.scene.output.png:       # the plots' imports (0.4-0.6 s) while FreeFEM solves, not at the end
+        # the transfer's scipy (0.5 s) and the plots' imports (0.4-0.6 s) while FreeFEM solves, not before the
+        # first launch or at the first remesh and the end
+        overlap.preload("scipy.spatial", "scipy.sparse")
+        if self.scene.output.png:
             overlap.preload("matplotlib", "matplotlib.pyplot")
         before, t0 = len(state.accepted), time.perf_counter()
         try:

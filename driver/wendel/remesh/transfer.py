@@ -33,7 +33,6 @@ split, the locator would sit apart from its only users.
 from __future__ import annotations
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from .quality import _as_arrays, signed_measure
 
@@ -53,6 +52,8 @@ def _closest_on_facets(points, facets, query):
     dim = points.shape[1]
     centroids = points[facets].mean(axis=1)
     k = min(8, len(facets))
+    from scipy.spatial import cKDTree      # here: scipy (0.5 s) is imported while FreeFEM solves (overlap.preload)
+
     _, cand = cKDTree(centroids).query(query, k=k)
     cand = cand.reshape(len(query), k)
     best_d = np.full(len(query), np.inf)
@@ -137,6 +138,8 @@ def locate(old_points, old_cells, new_points, tol=1e-9):
     jac = np.stack([pts[cells[:, i]] - x0 for i in range(1, dim + 1)], axis=-1)
     inv = np.linalg.inv(jac)
     centroids = pts[cells].mean(axis=1)
+    from scipy.spatial import cKDTree
+
     tree = cKDTree(centroids)
     cell = np.full(len(q), -1, dtype=np.int64)
     bary = np.zeros((len(q), dim + 1))
