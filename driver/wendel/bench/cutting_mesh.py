@@ -200,9 +200,10 @@ def cutting_steady_fbar_bench(quick: bool, workdir: Path) -> list[dict]:
     return _steady(quick, workdir, "fbar")
 
 
-def _steady(quick: bool, workdir: Path, volumetric: str) -> list[dict]:
-    """The 1.2 mm cut of ``cutting-steady`` with ``volumetric``: the remesh-cycle means, then one row of the last
-    window's spreads and drifts, the increments, step cuts, Newton iterations and the wall time."""
+def _steady(quick: bool, workdir: Path, volumetric: str, remesh_every: int | None = None) -> list[dict]:
+    """The 1.2 mm cut of ``cutting-steady`` with ``volumetric`` (and ``remesh_every`` increments between remeshes
+    instead of the scene's 8, if given): the remesh-cycle means, then one row of the last window's spreads and
+    drifts, the increments, step cuts, Newton iterations and the wall time."""
     import csv
 
     from ..cutting.fe_steady import steady
@@ -211,7 +212,9 @@ def _steady(quick: bool, workdir: Path, volumetric: str) -> list[dict]:
     scene.geometry.model_extra["length"] = 2.6e-3
     scene.cutting.cut_length = length
     scene.loading.steps = round(length / 5e-6)
-    out = workdir / "r2-long"
+    if remesh_every:
+        scene.cutting.remesh_every = remesh_every
+    out = workdir / ("r2-long" if not remesh_every else f"r2-long-remesh{remesh_every}")
     shutil.rmtree(out, ignore_errors=True)
     from ..cutting.fe_run import run_cut
     from ..errors import StepCutError
