@@ -107,3 +107,24 @@ def test_fe_cut_compiled_residual_pass_is_the_freefem_one(tmp_path):
             if (d / "done").is_file()]
     assert len(recs) >= 4 and max(r["friction_slip_nodes"] for r in recs) > 0
     assert all(r["friction_residual_diff"] == 0.0 for r in recs), [r["friction_residual_diff"] for r in recs]
+
+
+def test_fe_cut_fbar_compiled_patch_term_is_the_freefem_one(tmp_path):
+    # F-bar on the cut (contact rows: the patch term is added to K, not solved as the augmented system):
+    # kinematics-fbar.idp adds Dfree Y' Ds Z to K in one compiled pass (wendelFbarAdd); the same launch with
+    # -ul_fbar_product 1 (FreeFEM's sparse products and sum) takes the same Newton path to round-off.
+    from wendel import freefem
+    scene = load(STEEL, smoke=True)
+    scene.cutting.volumetric = "fbar"
+    root = run_cut(scene, STEEL, tmp_path / "cut", smoke=True, progress=lambda *_: None, frames=False)
+    words = (root / "freefem.log").read_text().splitlines()[0].split()
+    assert "-ul_volumetric" in words and words[words.index("-ul_volumetric") + 1] == "1"
+    opts = words[words.index("-out") + 2:]
+    out = tmp_path / "lang"
+    freefem.run("mechanics.edp", opts + ["-ul_fbar_product", "1"], out)
+    incs = sorted(d.name for d in out.glob("inc-*") if (d / "done").is_file())
+    assert len(incs) >= 2
+    for inc in incs:
+        a = [float(r["residual"]) for r in csv.DictReader((root / "fem" / inc / "newton.csv").open())]
+        b = [float(r["residual"]) for r in csv.DictReader((out / inc / "newton.csv").open())]
+        assert len(a) == len(b) >= 2 and max(abs(x - y) for x, y in zip(a, b)) < 1e-9 * max(a), (inc, a, b)

@@ -36,6 +36,13 @@
 //   long wendelFricRowsPQ(matrix M, long n, long nd, int[int] dof0, real[int] fE, real[int] Pb);
 //       M = P Q' (n x n: the identity with the contact nodes' blocks P_j Q_j').
 //
+//   long nnz = wendelFbarAdd(matrix K, matrix Y, matrix Z, real[int] sinv, real[int] fr);
+//       F-bar's patch term added to the Newton matrix (lib/kinematics-fbar.idp), in one pass:
+//         K = K + Dfree Y' diag(sinv) Z
+//       Y and Z nv x n (vertices x DoFs), sinv nv numbers (1 / the patch volumes), fr n numbers (1 for a free
+//       row, 0 for a Dirichlet one). The same sum as FreeFEM's (Y Dfree)' (Ds Z) then K + that product, without
+//       the three intermediate sparse matrices. Returns nnz(K).
+//
 //   long nc = wendelFricResidual(real[int] tool, real[int] par, int[int] dof0, real[int] u, real[int] u0,
 //                                real[int] res, real[int] state, real[int] out);
 //       lib/friction.idp's pass over the contact nodes at each residual (its fricResidual, the FreeFEM
@@ -257,6 +264,54 @@ long wendelFricFrame(Matrice_Creuse<double>* const& A, Matrice_Creuse<double>* c
         rowptr[i + 1] = (int)cols.size();
     }
     fricSetCsr(A, n, rowptr, cols, vals, "wendelFricFrame");
+    return (long)vals.size();
+}
+
+// F-bar's patch term added to the Newton matrix in one pass (lib/kinematics-fbar.idp): K = K + Dfree Y' Ds Z.
+long wendelFbarAdd(Matrice_Creuse<double>* const& K, Matrice_Creuse<double>* const& Y, Matrice_Creuse<double>* const& Z,
+                   KN<double>* const& sinv, KN<double>* const& fr)
+{
+    HashMatrix<int, double>*HK = K->pHM(), *HY = Y->pHM(), *HZ = Z->pHM();
+    if (!HK || !HY || !HZ) ExecError("wendelFbarAdd: K, Y and Z must be sparse matrices");
+    if (HK->half || HY->half || HZ->half) ExecError("wendelFbarAdd: the matrices must be stored whole");
+    const long n = HK->n, nv = HY->n;
+    if (HK->m != n || HY->m != n || HZ->m != n || HZ->n != nv)
+        ExecError("wendelFbarAdd: K must be n x n, Y and Z nv x n");
+    if (sinv->N() != nv || fr->N() != n) ExecError("wendelFbarAdd: sinv needs nv numbers, fr n");
+    HY->CSR();
+    HZ->CSR();
+    HK->CSR();
+    // Y' row by row (the vertices a of each DoF i, in increasing a)
+    std::vector<int> tp(n + 1, 0), ta(HY->nnz);
+    std::vector<double> tv(HY->nnz);
+    for (long q = 0; q < HY->nnz; ++q) ++tp[HY->j[q] + 1];
+    for (long i = 0; i < n; ++i) tp[i + 1] += tp[i];
+    std::vector<int> fill(tp.begin(), tp.end() - 1);
+    for (long a = 0; a < nv; ++a)
+        for (int q = HY->p[a]; q < HY->p[a + 1]; ++q) {
+            const int t = fill[HY->j[q]]++;
+            ta[t] = (int)a;
+            tv[t] = HY->aij[q];
+        }
+    std::vector<int> rowptr(n + 1, 0), cols, mark(n, -1), touched;
+    std::vector<double> vals, wk(n, 0.0), wf(n, 0.0);
+    cols.reserve(3 * HK->nnz);
+    vals.reserve(3 * HK->nnz);
+    for (long i = 0; i < n; ++i) {
+        touched.clear();
+        auto at = [&](int c) { if (mark[c] != i) { mark[c] = (int)i; wk[c] = 0.0; wf[c] = 0.0; touched.push_back(c); } };
+        for (int q = HK->p[i]; q < HK->p[i + 1]; ++q) { at(HK->j[q]); wk[HK->j[q]] += HK->aij[q]; }
+        if ((*fr)[i] != 0)
+            for (int t = tp[i]; t < tp[i + 1]; ++t) {
+                const int a = ta[t];
+                const double y = tv[t] * (*fr)[i];
+                for (int q = HZ->p[a]; q < HZ->p[a + 1]; ++q) { at(HZ->j[q]); wf[HZ->j[q]] += y * ((*sinv)[a] * HZ->aij[q]); }
+            }
+        std::sort(touched.begin(), touched.end());
+        for (int c : touched) { cols.push_back(c); vals.push_back(wk[c] + wf[c]); }
+        rowptr[i + 1] = (int)cols.size();
+    }
+    fricSetCsr(K, n, rowptr, cols, vals, "wendelFbarAdd");
     return (long)vals.size();
 }
 
@@ -642,6 +697,9 @@ static void Load_Init()
                                  KN<double>*, KN<double>*>(wendelFricResidual));
     Global.Add("wendelFricMass", "(",
                new OneOperator6_<long, long, KN<long>*, KN<double>*, KN<long>*, KN<double>*, KN<double>*>(wendelFricMass));
+    Global.Add("wendelFbarAdd", "(",
+               new OneOperator5_<long, Matrice_Creuse<double>*, Matrice_Creuse<double>*, Matrice_Creuse<double>*,
+                                 KN<double>*, KN<double>*>(wendelFbarAdd));
     Global.Add("wendelFricRowsPQ", "(",
                new OneOperator6_<long, Matrice_Creuse<double>*, long, long, KN<long>*, KN<double>*,
                                  KN<double>*>(wendelFricRowsPQ));

@@ -16,7 +16,7 @@ edge at the same step and with the same edge at the other step: ``(F_c - F_c_ref
 
 ``wendel bench cutting-steady``: the middle resolution cut 1.2 mm, twice the scene's length, on a longer block:
 the remesh-cycle means and whether they settle. ``wendel bench cutting-fbar``: the middle resolution with F-bar (``cutting.volumetric = "fbar"``), against
-the same case without it.
+the same case without it; ``wendel bench cutting-steady-fbar``: ``cutting-steady`` with F-bar.
 
 Each case is written to ``results/bench/work/cutting-mesh/<case>/``; a case whose folder already holds the
 finished cut of the same scene (``cutting.csv`` and ``summary.json`` of that ``scene.resolved.json``) is read,
@@ -190,15 +190,31 @@ def cutting_steady_bench(quick: bool, workdir: Path) -> list[dict]:
     (the primary zone stays clear of its far end): whether and where the forces and the chip settle within 2 %
     (:func:`wendel.cutting.fe_steady.steady` on the remesh-cycle means, a window of one h), with the last
     window's spreads and drifts. ``--quick``: 400 um."""
+    return _steady(quick, workdir, "cell")
+
+
+@register("cutting-steady-fbar")
+def cutting_steady_fbar_bench(quick: bool, workdir: Path) -> list[dict]:
+    """``cutting-steady`` with F-bar (``cutting.volumetric = "fbar"``): the same 1.2 mm cut at edge r/2, its
+    own folder and rows (an hour or more on one core; ``--quick``: 400 um)."""
+    return _steady(quick, workdir, "fbar")
+
+
+def _steady(quick: bool, workdir: Path, volumetric: str, remesh_every: int | None = None) -> list[dict]:
+    """The 1.2 mm cut of ``cutting-steady`` with ``volumetric`` (and ``remesh_every`` increments between remeshes
+    instead of the scene's 8, if given): the remesh-cycle means, then one row of the last window's spreads and
+    drifts, the increments, step cuts, Newton iterations and the wall time."""
     import csv
 
     from ..cutting.fe_steady import steady
-    scene = _scene(2, 1, quick=False)
+    scene = _scene(2, 1, quick=False, volumetric=volumetric)
     length = 0.4e-3 if quick else 1.2e-3
     scene.geometry.model_extra["length"] = 2.6e-3
     scene.cutting.cut_length = length
     scene.loading.steps = round(length / 5e-6)
-    out = workdir / "r2-long"
+    if remesh_every:
+        scene.cutting.remesh_every = remesh_every
+    out = workdir / ("r2-long" if not remesh_every else f"r2-long-remesh{remesh_every}")
     shutil.rmtree(out, ignore_errors=True)
     from ..cutting.fe_run import run_cut
     from ..errors import StepCutError
@@ -211,6 +227,7 @@ def cutting_steady_bench(quick: bool, workdir: Path) -> list[dict]:
         stopped = str(exc).split(";")[0]
     wall = time.perf_counter() - t0
     rows = [{k: float(v) for k, v in r.items()} for r in csv.DictReader((out / "cutting.csv").open())]
+    s = json.loads((out / "summary.json").read_text()) if (out / "summary.json").is_file() else {}
     st = steady(rows, scene.cutting.uncut_thickness)
     res = []
     for c in st["cycle_means"]:
@@ -221,5 +238,7 @@ def cutting_steady_bench(quick: bool, workdir: Path) -> list[dict]:
                 **{f"spread_{k}": v for k, v in st["last_window_spreads"]["cycles"].items()},
                 **{f"drift_{k}": v for k, v in st["last_window_trends"]["cycles"].items()},
                 **{f"inc_spread_{k}": v for k, v in st["last_window_spreads"]["raw"].items()},
+                "volumetric": volumetric, "increments": s.get("increments"), "step_cuts": s.get("step_cuts"),
+                "newton_iterations": s.get("newton_iterations"), "remeshes": len(s.get("remeshes", [])),
                 "wall_s": wall, "stopped": stopped})
     return res
