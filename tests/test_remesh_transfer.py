@@ -12,6 +12,7 @@ from pathlib import Path
 import meshio
 import numpy as np
 import pytest
+from scipy.spatial import cKDTree
 
 ROOT = Path(__file__).resolve().parents[1]
 try:
@@ -144,7 +145,7 @@ def test_remesh_2d_keeps_labels_and_domain(rect, tmp_path):
     for lab in (1, 2, 3, 4):
         old_nodes = np.unique(facets[ftags == lab])
         new_nodes = np.unique(nfacets[ntags == lab])
-        d, _ = transfer.cKDTree(x[old_nodes, :2]).query(npts[new_nodes, :2])
+        d, _ = cKDTree(x[old_nodes, :2]).query(npts[new_nodes, :2])
         assert d.max() < 0.06  # at most one old edge (h = 0.1 on a side stretched by at most 20 %) away
     # and the mesh is finer: h 0.05 instead of 0.1
     assert len(ncells) > 3 * len(cells)
