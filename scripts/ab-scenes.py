@@ -21,6 +21,7 @@ from __future__ import annotations
 import csv
 import json
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -67,7 +68,7 @@ def main(argv: list[str]) -> None:
         for scene in scenes:
             for name, tree in (("base", base), ("this", None)):
                 d = out / f"{scene}-{name}-{r}"
-                subprocess.run(["rm", "-rf", str(d)], check=True)
+                shutil.rmtree(d, ignore_errors=True)
                 s = run(tree, scene, d)
                 p = s["wall_time_by_phase"]
                 print(f"{scene} {name} round {r}: wall {s['wall_time']:.2f} s, assembly {p['assembly']:.2f} s, "
