@@ -92,6 +92,7 @@ def main(argv: list[str] | None = None) -> int:
                    "  cutting, cutting-isothermal (the FE orthogonal cut, about 15 minutes each),\n"
                    "  cutting-mesh (the FE cut at 3 edge resolutions and 2 steps, about an hour), cutting-fbar,\n"
                    "  cutting-steady (the FE cut to 1.2 mm, about 10-15 minutes), cutting-steady-fbar (the same with F-bar),\n"
+                   "  cutting-long (the FE cut to 2.4 mm, about 25 minutes),\n"
                    "  cutting-heat (the FE cut to 400 um adiabatic and with conduction, about 20 minutes),\n"
                    "  cutting-ti (the titanium FE cut on the graded mesh, about 10 minutes),\n"
                    "  cutting-kienzle (the FE Kienzle campaign: 8 cuts by wendel sweep, about 40 core minutes),\n"

@@ -200,21 +200,32 @@ def cutting_steady_fbar_bench(quick: bool, workdir: Path) -> list[dict]:
     return _steady(quick, workdir, "fbar")
 
 
-def _steady(quick: bool, workdir: Path, volumetric: str, remesh_every: int | None = None) -> list[dict]:
-    """The 1.2 mm cut of ``cutting-steady`` with ``volumetric`` (and ``remesh_every`` increments between remeshes
-    instead of the scene's 8, if given): the remesh-cycle means, then one row of the last window's spreads and
-    drifts, the increments, step cuts, Newton iterations and the wall time."""
+@register("cutting-long")
+def cutting_long_bench(quick: bool, workdir: Path) -> list[dict]:
+    """``cutting-steady`` cut twice as far, 2.4 mm (16 h) on a block 3.8 mm long (about 25 minutes on one core):
+    whether the forces settle after the 1.2 mm, with the means over each 150 um of travel (``bin`` rows) and
+    over the last 1.5 mm (``mean_*`` in the last row). ``--quick``: the 400 um of ``cutting-steady --quick``."""
+    return _steady(quick, workdir, "cell", length=2.4e-3, block=3.8e-3, folder="r2-2400um")
+
+
+def _steady(quick: bool, workdir: Path, volumetric: str, remesh_every: int | None = None,
+            length: float = 1.2e-3, block: float = 2.6e-3, folder: str | None = None) -> list[dict]:
+    """The 1.2 mm cut of ``cutting-steady`` (or ``length`` [m] on a block ``block`` [m] long, in ``folder``) with
+    ``volumetric`` (and ``remesh_every`` increments between remeshes instead of the scene's 8, if given): the
+    remesh-cycle means, then one row of the last window's spreads and drifts, the increments, step cuts, Newton
+    iterations and the wall time."""
     import csv
 
-    from ..cutting.fe_steady import steady
+    from ..cutting.fe_steady import steady, window
     scene = _scene(2, 1, quick=False, volumetric=volumetric)
-    length = 0.4e-3 if quick else 1.2e-3
-    scene.geometry.model_extra["length"] = 2.6e-3
+    long = length > 1.2e-3
+    length = 0.4e-3 if quick else length
+    scene.geometry.model_extra["length"] = block
     scene.cutting.cut_length = length
     scene.loading.steps = round(length / 5e-6)
     if remesh_every:
         scene.cutting.remesh_every = remesh_every
-    out = workdir / ("r2-long" if not remesh_every else f"r2-long-remesh{remesh_every}")
+    out = workdir / (folder or ("r2-long" if not remesh_every else f"r2-long-remesh{remesh_every}"))
     shutil.rmtree(out, ignore_errors=True)
     from ..cutting.fe_run import run_cut
     from ..errors import StepCutError
@@ -234,7 +245,18 @@ def _steady(quick: bool, workdir: Path, volumetric: str, remesh_every: int | Non
         res.append({"travel_um": c["tool_travel_m"] * 1e6, "Fc_N": c["Fc_N"], "Ft_N": c["Ft_N"],
                     "chip_um": c["chip_thickness_m"] * 1e6})
     found = st["cycles"]
+    means = {}
+    if long and not quick:      # the means over each 150 um of travel and over the last 1.5 mm (work over travel)
+        t = np.array([r["tool_travel_m"] for r in rows])
+        for lo in np.arange(0.0, t[-1] - 1e-12, 150e-6):
+            w = window([r for r in rows if r["tool_travel_m"] <= lo + 150e-6 + 1e-12], 150e-6)
+            res.append({"travel_um": (lo + 75e-6) * 1e6, "bin": True, "Fc_N": w["steady_Fc_N"],
+                        "Ft_N": w["steady_Ft_N"], "chip_um": w["steady_chip_m"] * 1e6})
+        w = window(rows, 1.5e-3)
+        means = {"mean_from_um": w["steady_window_from_m"] * 1e6, "mean_Fc_N": w["steady_Fc_N"],
+                 "mean_Ft_N": w["steady_Ft_N"], "mean_chip_um": w["steady_chip_m"] * 1e6}
     res.append({"travel_um": rows[-1]["tool_travel_m"] * 1e6, "steady_from_um": found["start_m"] * 1e6 if found else None,
+                **means,
                 **{f"spread_{k}": v for k, v in st["last_window_spreads"]["cycles"].items()},
                 **{f"drift_{k}": v for k, v in st["last_window_trends"]["cycles"].items()},
                 **{f"inc_spread_{k}": v for k, v in st["last_window_spreads"]["raw"].items()},
