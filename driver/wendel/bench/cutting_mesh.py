@@ -204,8 +204,13 @@ def cutting_steady_fbar_bench(quick: bool, workdir: Path) -> list[dict]:
 def cutting_long_bench(quick: bool, workdir: Path) -> list[dict]:
     """``cutting-steady`` cut twice as far, 2.4 mm (16 h) on a block 3.8 mm long (about 25 minutes on one core):
     whether the forces settle after the 1.2 mm, with the means over each 150 um of travel (``bin`` rows) and
-    over the last 1.5 mm (``mean_*`` in the last row). ``--quick``: the 400 um of ``cutting-steady --quick``."""
-    return _steady(quick, workdir, "cell", length=2.4e-3, block=3.8e-3, folder="r2-2400um")
+    over the last 1.5 mm (``mean_*`` in the last row). ``WENDEL_BENCH_CUT_MM``: another length [mm] (the block 1.4 mm
+    longer, its own folder). ``--quick``: the 400 um of ``cutting-steady --quick``."""
+    import os
+    mm = float(os.environ.get("WENDEL_BENCH_CUT_MM", "2.4"))
+    if not 1.2 < mm <= 20.0:
+        raise ValueError(f"WENDEL_BENCH_CUT_MM = {mm}: a length of cut in mm above 1.2 (cutting-steady's) and up to 20")
+    return _steady(quick, workdir, "cell", length=mm * 1e-3, block=(mm + 1.4) * 1e-3, folder=f"r2-{mm * 1e3:.0f}um")
 
 
 def _steady(quick: bool, workdir: Path, volumetric: str, remesh_every: int | None = None,
