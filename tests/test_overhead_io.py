@@ -53,3 +53,38 @@ cout << "not reached" << endl;
     assert (tmp_path / "first.bin").is_file()
     assert not (tmp_path / "third.bin").exists() and not (tmp_path / "done").exists()
     assert "not reached" not in r.stdout
+
+
+def test_vtu_written_at_zlib_level_1_reads_back_bit_for_bit(tmp_path):
+    """write_vtu compresses meshio's blocks at vtu.ZLIB_LEVEL (issue 20): still a vtkZLibDataCompressor VTU,
+    every field read back by meshio bit for bit, its blocks those of zlib at that level (not meshio's 6)."""
+    import base64
+    import re
+    import zlib
+
+    import meshio
+    import numpy as np
+
+    rng = np.random.default_rng(5)
+    pts = rng.random((400, 3))
+    cells = rng.integers(0, 400, (900, 4))
+    point_data = {"u": rng.standard_normal((400, 3)), "T": rng.random(400)}
+    cell_data = {"vonMises": [rng.random(900)], "strain_xx": [rng.standard_normal(900) * 1e-3]}
+    path = tmp_path / "inc.vtu"
+    vtu.write_vtu(path, pts, cells, 3, point_data, cell_data)
+    text = path.read_text()
+    assert 'compressor="vtkZLibDataCompressor"' in text
+    m = meshio.read(path)
+    assert np.array_equal(m.points, pts) and np.array_equal(m.cells[0].data, cells)
+    assert all(np.array_equal(m.point_data[k], v) for k, v in point_data.items())
+    assert all(np.array_equal(m.cell_data[k][0], v[0]) for k, v in cell_data.items())
+    # the vonMises array: its header (4 UInt32: blocks, block size, last size, compressed size) in base64,
+    # then the one block in base64
+    block = re.search(r'Name="vonMises"[^>]*>\s*([A-Za-z0-9+/=]+)', text).group(1)
+    assert 'header_type="UInt64"' not in text          # meshio's default header, UInt32
+    head = np.frombuffer(base64.b64decode(block[:24]), dtype=np.uint32)
+    assert head[0] == 1
+    body = base64.b64decode(block[24:])
+    assert len(body) == head[3]
+    assert body == zlib.compress(cell_data["vonMises"][0].tobytes(), vtu.ZLIB_LEVEL) != \
+        zlib.compress(cell_data["vonMises"][0].tobytes())
