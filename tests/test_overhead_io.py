@@ -88,3 +88,24 @@ def test_vtu_written_at_zlib_level_1_reads_back_bit_for_bit(tmp_path):
     assert len(body) == head[3]
     assert body == zlib.compress(cell_data["vonMises"][0].tobytes(), vtu.ZLIB_LEVEL) != \
         zlib.compress(cell_data["vonMises"][0].tobytes())
+
+
+def test_driver_arrays_are_savevec_bytes_that_freefem_reads_back(tmp_path):
+    """vtu.write_array (the state the driver writes after a remesh, the predictor's increment) writes SaveVec's
+    bytes: read_array gives the values bit for bit, and FreeFEM's readArray (lib/common.idp) reads them."""
+    import numpy as np
+
+    v = np.array([0.1, -1e-300, 1.0 / 3.0, 6.02214076e23, -0.0, 5e-324, np.pi])
+    vtu.write_array(tmp_path / "a.txt", v)
+    raw = (tmp_path / "a.txt").read_bytes()
+    assert raw == (7).to_bytes(8, "little") + v.astype("<f8").tobytes()
+    assert np.array_equal(vtu.read_array(tmp_path / "a.txt"), v)
+    script = tmp_path / "read.edp"
+    script.write_text('include "lib/common.idp"\nreal[int] a(7);\nreadArray("a.txt", a)\ncout.precision(17);\n'
+                      'for (int i = 0; i < 7; ++i) cout << "value " << a[i] << endl;\n')
+    env = dict(freefem.environment(), OMPI_MCA_ess_singleton_isolated="1")
+    r = subprocess.run(["FreeFem++-mpi", "-nw", "-v", "0", str(script), "-out", str(tmp_path)], cwd=tmp_path, env=env,
+                       capture_output=True, text=True, timeout=60)
+    assert r.returncode == 0, r.stdout + r.stderr
+    got = [float(line.split()[1]) for line in r.stdout.splitlines() if line.startswith("value ")]
+    assert got == v.tolist()

@@ -79,12 +79,13 @@ def complete_array(path: Path) -> bool:
 
 
 def write_array(path: Path, values) -> None:
-    """Write edp's plain array format (count, then one value per line, full precision)."""
-    v = np.asarray(values, dtype=float).ravel()
-    with open(path, "w") as f:
-        f.write(f"{v.size}\n")
-        f.write("\n".join(map(repr, v.tolist())))     # shortest round-trip text, 5x faster than savetxt
-        f.write("\n")
+    """Write an array as FreeFEM's BinaryIO ``SaveVec`` does (the count as a little-endian int64, then float64
+    values): what edp's ``readArray`` and :func:`read_array` read, the same values as the 17-digit text this
+    wrote before, without formatting them (drilling-3d: 0.3 s of text for 56 state files; issue 20)."""
+    v = np.ascontiguousarray(np.asarray(values, dtype=float).ravel(), dtype="<f8")
+    with open(path, "wb") as f:
+        f.write(v.size.to_bytes(8, "little"))
+        f.write(v.tobytes())
 
 
 def read_mesh(path: Path, dimension: int) -> tuple[np.ndarray, np.ndarray]:
