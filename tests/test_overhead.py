@@ -229,15 +229,15 @@ def test_accepting_while_freefem_solves_gives_the_same_run(tmp_path, monkeypatch
         raw = f.read_bytes()
         assert raw[7] == 0 and len(raw) == 8 + 8 * int.from_bytes(raw[:8], "little") and complete_array(f), f
         np.testing.assert_array_equal(read_array(f), np.ravel(cell_data[f.name.removesuffix(".cell.txt")][0]))
-    # node fields and quadrature-point state too (issue 20); after each remesh FreeFEM read the driver's text
-    # state (the same run as above: the increments after a remesh continued from it)
+    # node fields and quadrature-point state too (issue 20); after each remesh FreeFEM read the driver's state,
+    # binary as well since session 14 (the same run as above: the increments after a remesh continued from it)
     state = sorted((behind / "fem" / last.stem).glob("*.node.txt")) + sorted((behind / "fem" / last.stem).glob("*.qp.txt"))
     assert {"u.node.txt", "plast_epsp.qp.txt"} <= {f.name for f in state}
     for f in state:
         raw_state = f.read_bytes()
         assert raw_state[7] == 0 and complete_array(f) and read_array(f).size > 0, f
-    driver_text = sorted((behind / "remesh").glob("state-*/plast_epsp.qp.txt"))
-    assert s1["remeshes"] and driver_text and all(p.read_bytes().split(b"\n", 1)[0].isdigit() for p in driver_text)
+    driver_state = sorted((behind / "remesh").glob("state-*/plast_epsp.qp.txt"))
+    assert s1["remeshes"] and driver_state and all(p.read_bytes()[7] == 0 and complete_array(p) for p in driver_state)
     cut = tmp_path / "cut.cell.txt"
     cut.write_bytes(raw[:-3])
     assert not complete_array(cut)

@@ -201,6 +201,32 @@ def test_transfer_onto_the_identical_mesh_is_the_identity(box):
     assert out == 0 and np.array_equal(pc, p)
 
 
+@pytest.mark.parametrize("mesh", ["rect", "box"])
+def test_locate_finds_the_cell_of_the_largest_smallest_coordinate_and_follows_moved_points(mesh, request):
+    """locate (candidates tested at once, each mesh's set-up kept for the next call) against a brute force over
+    every cell: the same cell where a point is inside one (issue 20); a mesh whose points moved is not served
+    from the kept set-up of the mesh before."""
+    pts, dim, cells, _, _ = _read(request.getfixturevalue(mesh))
+    pts = pts[:, :dim]
+    rng = np.random.default_rng(3)
+    q = np.vstack([rng.random((200, dim)) * 1.1 - 0.05, pts[:20]])      # some outside, some on vertices
+    for points in (pts, _shear(np.column_stack([pts, np.zeros((len(pts), 3 - dim))]))[:, :dim]):
+        cell, bary = transfer.locate(points, cells, q)
+        cell2, bary2 = transfer.locate(points.copy(), cells.copy(), q)             # the kept set-up
+        assert np.array_equal(cell, cell2) and np.array_equal(bary, bary2)
+        x0 = points[cells[:, 0]]
+        inv = np.linalg.inv(np.stack([points[cells[:, i]] - x0 for i in range(1, dim + 1)], axis=-1))
+        lam = np.einsum("cij,pcj->pci", inv, q[:, None, :] - x0[None])
+        lam = np.concatenate([(1 - lam.sum(axis=2))[:, :, None], lam], axis=2)
+        worst = lam.min(axis=2)
+        inside = worst.max(axis=1) >= -1e-9
+        assert np.array_equal(cell >= 0, inside)
+        got = worst[np.arange(len(q)), np.maximum(cell, 0)]
+        assert np.allclose(got[inside], worst.max(axis=1)[inside], rtol=0, atol=1e-12)
+        xb = np.einsum("pk,pkd->pd", bary[inside], points[cells[cell[inside]]])
+        assert np.allclose(xb, q[inside], rtol=0, atol=1e-9)
+
+
 def test_transfer_error_falls_as_h_squared(tmp_path):
     """Nodal P1 interpolation error at the new nodes is O(h^2); cell fields through recovery too (inside)."""
     hs = [0.1, 0.05, 0.025]

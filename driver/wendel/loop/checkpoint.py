@@ -83,7 +83,9 @@ def save(files: RunFiles, scene: Scene, state: State, dimension: int) -> None:
             "quality": {str(k): v for k, v in state.quality.items()}, "step": state.step,
             "launches": state.launches, "mesh_seconds": state.mesh_seconds, "post_seconds": state.post_seconds,
             "behind_seconds": state.behind_seconds}
-    text = json.dumps(data, indent=1).encode()
+    # one line: json's C encoder (an indent takes its Python one: 4.3 against 0.7 ms a save of drilling-deep-rz's
+    # 62 kB at its end, one save per increment; issue 20)
+    text = json.dumps(data).encode()
     # One save at a time (the driver thread and the output thread of loop/overlap.py both save), each through a
     # temporary file of its own written unbuffered: a save interrupted by Ctrl-C or SIGTERM can then never write
     # into the checkpoint another save has put in place (measured once: checkpoint.json ended in 17 stray bytes).

@@ -332,8 +332,8 @@ class Process:
         # the transfer's scipy (0.5 s) and the plots' imports (0.4-0.6 s) while FreeFEM solves, not before the
         # first launch or at the first remesh and the end
         overlap.preload("scipy.spatial", "scipy.sparse")
-        if self.scene.output.png:
-            overlap.preload("matplotlib", "matplotlib.pyplot")
+        if self.scene.output.png:       # and a first figure drawn (fonts, text, log labels: wendel.results.plotwarm)
+            overlap.preload("matplotlib", "matplotlib.pyplot", "wendel.results.plotwarm")
         before, t0 = len(state.accepted), time.perf_counter()
         try:
             # the next launch starts beside this solve at nice 19 (its start takes only the CPU the solve leaves;

@@ -112,6 +112,47 @@ def _closest_on_triangle(p, a, b, c):
     return np.nan_to_num(w)
 
 
+class _Locator:
+    """What :func:`locate` needs of one old mesh, computed once: the first vertices, the inverse Jacobians,
+    the centroids' cKDTree and the largest centroid-vertex distance (the drilling loop locates several point
+    sets in one mesh: the new nodes, the new quadrature points, the removed slice, the probes)."""
+
+    def __init__(self, pts, cells, dim):
+        self.n = len(cells)
+        self.x0 = pts[cells[:, 0]]
+        jac = np.stack([pts[cells[:, i]] - self.x0 for i in range(1, dim + 1)], axis=-1)
+        self.inv = np.linalg.inv(jac)
+        self.centroids = pts[cells].mean(axis=1)
+        from scipy.spatial import cKDTree
+
+        self.tree = cKDTree(self.centroids)
+        self._radius, self._pts, self._cells = None, pts, cells
+
+    @property
+    def radius(self):
+        if self._radius is None:
+            self._radius = np.linalg.norm(self._pts[self._cells] - self.centroids[:, None, :], axis=2).max() * (1 + 1e-9)
+        return self._radius
+
+
+_LOCATORS: dict = {}
+"""Recent meshes' :class:`_Locator` by the bytes of their points and cells (a few: they are small)."""
+
+
+def _locator(pts, cells, dim) -> _Locator:
+    import hashlib
+
+    key = (pts.shape, cells.shape, hashlib.blake2b(np.ascontiguousarray(pts)).digest()
+           + hashlib.blake2b(np.ascontiguousarray(cells)).digest())
+    loc = _LOCATORS.pop(key, None)
+    if loc is None:
+        loc = _Locator(pts, cells, dim)
+    _LOCATORS[key] = loc                      # the most recent last
+    while len(_LOCATORS) > 4:
+        del _LOCATORS[next(iter(_LOCATORS))]
+    return loc
+
+
 def locate(old_points, old_cells, new_points, tol=1e-9):
     """Find the old element containing each new point.
 
@@ -134,43 +175,37 @@ def locate(old_points, old_cells, new_points, tol=1e-9):
     pts, cells, dim = _as_arrays(old_points, old_cells)
     q = np.asarray(new_points, dtype=float)
     q = q.reshape(-1, dim) if q.ndim == 1 else q[:, :dim]
-    x0 = pts[cells[:, 0]]
-    jac = np.stack([pts[cells[:, i]] - x0 for i in range(1, dim + 1)], axis=-1)
-    inv = np.linalg.inv(jac)
-    centroids = pts[cells].mean(axis=1)
-    from scipy.spatial import cKDTree
-
-    tree = cKDTree(centroids)
+    loc = _locator(pts, cells, dim)
+    inv, x0 = loc.inv, loc.x0
     cell = np.full(len(q), -1, dtype=np.int64)
     bary = np.zeros((len(q), dim + 1))
 
     def test(idx, cand):
-        """Try candidate cells cand (len(idx), k) for points idx; keep the one with the largest min coordinate."""
-        best = np.full(len(idx), -np.inf)
-        for j in range(cand.shape[1]):
-            c = cand[:, j]
-            valid = c < len(cells)
-            c = np.where(valid, c, 0)
-            lam = np.einsum("nij,nj->ni", inv[c], q[idx] - x0[c])
-            lam = np.column_stack([1 - lam.sum(axis=1), lam])
-            worst = np.where(valid, lam.min(axis=1), -np.inf)
-            better = worst > best
-            best[better] = worst[better]
-            cell[idx[better]] = c[better]
-            bary[idx[better]] = lam[better]
+        """Try candidate cells cand (len(idx), k) for points idx; keep the one with the largest min coordinate
+        (the first of equals), all candidates at once."""
+        valid = cand < loc.n
+        c = np.where(valid, cand, 0)
+        lam = np.einsum("nkij,nkj->nki", inv[c], q[idx][:, None, :] - x0[c])
+        lam = np.concatenate([(1 - lam.sum(axis=2))[:, :, None], lam], axis=2)
+        worst = np.where(valid, lam.min(axis=2), -np.inf)
+        j = worst.argmax(axis=1)
+        rows = np.arange(len(idx))
+        best = worst[rows, j]
+        some = best > -np.inf
+        cell[idx[some]] = c[rows, j][some]
+        bary[idx[some]] = lam[rows, j][some]
         cell[idx[best < -tol]] = -1
 
     todo = np.arange(len(q))
     for k in (8, 32):
         if len(todo) == 0:
             break
-        k = min(k, len(cells))
-        _, cand = tree.query(q[todo], k=k)
+        k = min(k, loc.n)
+        _, cand = loc.tree.query(q[todo], k=k)
         test(todo, cand.reshape(len(todo), k))
         todo = todo[cell[todo] < 0]
     if len(todo):
-        radius = np.linalg.norm(pts[cells] - centroids[:, None, :], axis=2).max() * (1 + 1e-9)
-        for i, near in zip(todo, tree.query_ball_point(q[todo], radius)):
+        for i, near in zip(todo, loc.tree.query_ball_point(q[todo], loc.radius)):
             if near:
                 test(np.array([i]), np.array([near]))
     found = cell >= 0
