@@ -9,8 +9,9 @@ remesh threshold of 0.1, so the cut was remeshed after every increment from 720 
 
 :func:`smooth` drops such nodes from the boundary polygon before gmsh sees it: a node whose two boundary
 neighbours are closer than the local target size ``s`` (the new mesh could not place a node between them anyway)
-and which stands less than ``feature * s`` off their chord. The least deviating node goes first, and its
-neighbours are judged again. Nodes where the boundary label changes and non-manifold nodes stay, and a chord that
+and which stands less than ``feature * s`` off their chord, as do the nodes dropped before between them (so the
+old polygon's nodes stay within ``feature * s`` of the new one). The node whose drop changes the area least goes
+first (Visvalingam and Whyatt's order: the tip of a notch before its sides), and its neighbours are judged again. Nodes where the boundary label changes and non-manifold nodes stay, and a chord that
 would cross another boundary edge is not taken. The domain changes by the small triangles cut off or added
 (less than ``feature * s`` deep each); new nodes outside the old mesh get the nearest old boundary values
 (:mod:`wendel.remesh.transfer`).
@@ -92,22 +93,28 @@ def smooth(points: np.ndarray, edges: np.ndarray, labels: np.ndarray, size: np.n
     fixed = {n for n in set(degree_out) | set(degree_in)
              if degree_out.get(n, 0) != 1 or degree_in.get(n, 0) != 1 or lab_out.get(n) != lab_in.get(n)}
     removed: set[int] = set()
+    hidden: dict[int, list[int]] = {}       # the dropped nodes of the edge that starts at a node
 
     def score(n):
-        """deviation / allowed deviation, or None when ``n`` may not go."""
+        """The area of the triangle ``n`` and its neighbours, or None when ``n`` may not go: every node the chord
+        would replace (``n`` and those its two edges replace already) within ``feature`` times the size at ``n``
+        of it."""
         if n in fixed or n in removed:
             return None
         p, q = prv[n], nxt[n]
         if p == q or nxt.get(q) == p:       # a loop of three nodes stays
             return None
         chord = pts[q] - pts[p]
-        c = float(np.hypot(*chord))
-        if c >= size[n] or c <= 0:
+        c2 = float(chord @ chord)
+        if c2 >= size[n] ** 2 or c2 <= 0:
             return None
-        dev = abs(chord[0] * (pts[n, 1] - pts[p, 1]) - chord[1] * (pts[n, 0] - pts[p, 0])) / c
+        under = pts[hidden.get(p, []) + [n] + hidden.get(n, [])] - pts[p]
+        t = np.clip(under @ chord / c2, 0.0, 1.0)
+        dev = float(np.sqrt(((under - t[:, None] * chord) ** 2).sum(axis=1)).max())
         if dev >= feature * size[n]:
             return None
-        return dev / (feature * size[n])
+        e = pts[n] - pts[p]
+        return 0.5 * abs(chord[0] * e[1] - chord[1] * e[0])     # the area the drop changes: least first
 
     heap = [(sc, n, p_, q_) for n in nxt if (sc := score(n)) is not None for p_, q_ in [(prv[n], nxt[n])]]
     heapq.heapify(heap)
@@ -122,6 +129,7 @@ def smooth(points: np.ndarray, edges: np.ndarray, labels: np.ndarray, size: np.n
         if len(live) and _crosses(pts[p], pts[q], pts[live[:, 0]], pts[live[:, 1]]).any():
             continue
         removed.add(n)
+        hidden[p] = hidden.get(p, []) + [n] + hidden.pop(n, [])
         nxt[p], prv[q] = q, p
         del nxt[n], prv[n]
         for m in (p, q):
