@@ -162,12 +162,14 @@ def _cut_chains(cut, boundary_nodes, points, feature_angle):
 
 
 def _edge_body(cells, body, edges):
-    """The body of each boundary edge (the body of the cell it bounds)."""
-    table = {}
+    """The body of each boundary edge (the body of the cell it bounds; of a chord that replaced boundary edges,
+    :mod:`wendel.remesh.features`, the body of its first node's cells)."""
+    table, node = {}, {}
     for c, tri in enumerate(cells.tolist()):
         for a, b in ((tri[0], tri[1]), (tri[1], tri[2]), (tri[2], tri[0])):
             table[(a, b)] = body[c]
-    return np.array([table[(a, b)] for a, b in edges.tolist()], dtype=np.int64)
+            node[a] = body[c]
+    return np.array([table[(a, b)] if (a, b) in table else node[a] for a, b in edges.tolist()], dtype=np.int64)
 
 
 def _add_curves(gmsh, pts, chains, groups, next_curve, points_done):

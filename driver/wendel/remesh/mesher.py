@@ -36,7 +36,7 @@ import numpy as np
 from ..meshes import LABELS
 from ..meshes.builders import start_gmsh
 from ..results import meshfile
-from . import bodies, quality
+from . import bodies, features, quality
 
 OPENED = LABELS["opened"]      # the faces a DG separation opened (separated.msh)
 
@@ -199,7 +199,7 @@ def _zone_field(gmsh, zone, h):
 
 
 def remesh(points_deformed, mesh_in_path, out_path, h, size_indicator=None, h_min=None,
-           feature_angle=30.0, optimize=True, algorithm_3d=10, zones=None, algorithm_2d=None):
+           feature_angle=30.0, optimize=True, algorithm_3d=10, zones=None, algorithm_2d=None, smooth_features=0.0):
     """Mesh the deformed body anew from its boundary; write MSH 2.2 with the same labels.
 
     Parameters
@@ -230,6 +230,9 @@ def remesh(points_deformed, mesh_in_path, out_path, h, size_indicator=None, h_mi
         gmsh ``Mesh.Algorithm3D`` (10 = HXT, 1 = Delaunay).
     algorithm_2d : int, optional
         gmsh ``Mesh.Algorithm`` (default gmsh's 6 = Frontal-Delaunay; 5 = Delaunay, 1 = MeshAdapt).
+    smooth_features : float
+        2D: old boundary nodes between neighbours closer than the local target size that stand less than this
+        share of it off their chord are dropped before meshing (:mod:`wendel.remesh.features`); 0: none.
 
     Returns
     -------
@@ -269,6 +272,12 @@ def remesh(points_deformed, mesh_in_path, out_path, h, size_indicator=None, h_mi
     bf = boundary_facets(cells)
     labels = _label_facets(bf, facets, facet_tags)
     h_min = h / 4 if h_min is None else h_min
+    smoothed = 0
+    if dim == 2 and smooth_features > 0 and cut is None:    # sub-resolution wrinkles of the boundary
+        size = features.target_size(pts, h, size_indicator, h_min, zones)
+        n_edges = len(bf)
+        bf, labels = features.smooth(pts, bf, labels, size, smooth_features)
+        smoothed = n_edges - len(bf)
 
     start_gmsh()          # keeps the driver's Ctrl-C and SIGTERM handlers
     try:
@@ -349,6 +358,7 @@ def remesh(points_deformed, mesh_in_path, out_path, h, size_indicator=None, h_mi
         "boundary_labels": sorted(int(k) for k in groups),
         "domain_label": domain_label,
         "unlabelled_facets": int(np.count_nonzero(labels == 0)),
+        "boundary_nodes_smoothed": int(smoothed),
         "measure_old": float(meas_old.sum()),
         "measure_new": float(quality.signed_measure(x, new_cells).sum()),
         "min_sicn": q["min"],

@@ -87,7 +87,8 @@ def yield_violation(eps0: np.ndarray, epsp: np.ndarray, sigma_y: np.ndarray, mu:
 def remesh_state(inc_dir: Path, mesh_old: Path, ubase_old: np.ndarray | None, dimension: int,
                  mesh_new: Path, state_new: Path, h: float, h_min: float, indicator: str,
                  mu: float | None = None, axisymmetric: bool = False, make_mesh=None,
-                 deformed: bool = True, zones: list[dict] | None = None, algorithm_2d: int | None = None) -> dict:
+                 deformed: bool = True, zones: list[dict] | None = None, algorithm_2d: int | None = None,
+                 smooth_features: float = 0.0) -> dict:
     """Mesh the deformed body of increment ``inc_dir`` anew and write the transferred state.
 
     Writes ``mesh_new`` and, in ``state_new``, ``u.node.txt`` (zeros), ``ubase.txt``, ``eps0.txt`` and the
@@ -97,7 +98,7 @@ def remesh_state(inc_dir: Path, mesh_old: Path, ubase_old: np.ndarray | None, di
     ``make_mesh`` replaces :func:`wendel.remesh.mesher.remesh` (same arguments and report keys), e.g. the material
     removal of :mod:`wendel.drilling`; ``deformed = False`` transfers in the reference configuration
     (small strain: the new mesh is made from the original geometry); ``zones``: boxes of finer size
-    (:func:`wendel.remesh.mesher.remesh`).
+    (:func:`wendel.remesh.mesher.remesh`); ``smooth_features``: :mod:`wendel.remesh.features`.
     """
     from . import mesher, transfer
 
@@ -114,8 +115,9 @@ def remesh_state(inc_dir: Path, mesh_old: Path, ubase_old: np.ndarray | None, di
         size_ind = transfer.cell_to_nodes(xd, cells, cellfield(indicator)[:, 0], axisymmetric=axisymmetric)
     with _quiet_stdout():
         info = (make_mesh or mesher.remesh)(xd, mesh_old, mesh_new, h, size_indicator=size_ind, h_min=h_min,
-                                            **({"zones": zones} if zones else {}),
-                                            **({"algorithm_2d": algorithm_2d} if algorithm_2d is not None else {}))
+                                            **({"zones": zones} if zones else {}), **{k: v for k, v in (
+                                                ("algorithm_2d", algorithm_2d), ("smooth_features", smooth_features))
+                                                if v})
     t1 = time.perf_counter()
     Y, new_cells = vtu.read_mesh(mesh_new, dimension)
     Y = Y[:, :dimension]
@@ -123,7 +125,8 @@ def remesh_state(inc_dir: Path, mesh_old: Path, ubase_old: np.ndarray | None, di
     report = {"old_nodes": n_old, "old_elements": len(cells), "new_nodes": len(Y), "new_elements": len(new_cells),
               "min_quality_before": before["min"], "inverted_before": before["inverted"],
               "min_quality_after": info["min_sicn"], "measure_old": info["measure_old"],
-              "measure_new": info["measure_new"], "remesh_seconds": t1 - t0}
+              "measure_new": info["measure_new"], "remesh_seconds": t1 - t0,
+              "boundary_nodes_smoothed": info.get("boundary_nodes_smoothed", 0)}
     # Every field goes through one point location: nodal fields as they are, cell fields recovered
     # to nodes (volume-weighted, integral kept), all stacked, interpolated once, split again.
     utot = u + (ubase_old if ubase_old is not None else 0.0)
@@ -287,7 +290,7 @@ def maybe_remesh(scene, files, state, dimension: int, progress, again: int = 0) 
         files.fem / f"inc-{inc:04d}", files.root / seg["mesh"], ubase_old, dimension, files.root / mesh_new,
         files.root / state_dir, h, r.h_min or h / 3, r.indicator, mu=scene.material.E / (2 * (1 + scene.material.nu)),
         axisymmetric=scene.elasticity.plane == "axisymmetric", zones=zones_at(r, files.fem / f"inc-{inc:04d}"),
-        algorithm_2d=AGAIN[again - 1] if again else None), k, inc, lf, q, files.root)
+        algorithm_2d=AGAIN[again - 1] if again else None, smooth_features=r.smooth_features), k, inc, lf, q, files.root)
     rep.update({"remesh": k, "after_increment": inc, "load_factor": lf, "dimension": dimension,
                 "algorithm_2d_tries": again})
     state.remeshes.append(rep)

@@ -291,6 +291,10 @@ class Remesh(Strict):
                              "Newton (1: at once) [1]")
     zones: list[RemeshZone] = Field(default_factory=list, description="boxes of finer size [[remesh.zones]] "
                                     "(box, h, thickness), graded to remesh.h outside them")
+    smooth_features: float = Field(0.0, ge=0, lt=0.5, description="2D: before meshing, drop old boundary nodes "
+                                   "whose neighbours are closer than the local target size and that stand less than "
+                                   "this share of it off their chord (wrinkles the new mesh cannot resolve; "
+                                   "wendel.remesh.features) [1]; 0: keep every node")
     zones_follow: Literal["body", "tool"] = Field("body", description="body: the zones stand where they are "
                                                   "written; tool: they move with contact.path (written for "
                                                   "the tool at load factor 0)")

@@ -98,6 +98,11 @@ class Cutting(BaseModel):
     volumetric: Literal["cell", "fbar"] = Field("cell", description="FE: the updated-Lagrangian volume change, "
                                                 "per cell (P1, locks in the isochoric plastic flow) or F-bar "
                                                 "(kinematics.volumetric)")
+    smooth_features: Optional[float] = Field(None, ge=0, lt=0.5, description="FE: the remeshes drop old boundary "
+                                             "nodes of features below the new mesh's size, as remesh.smooth_features "
+                                             "[1]; default 0.25 with volumetric = fbar (its chip front folds into "
+                                             "notches a few um deep: fresh meshes of quality 0.09, measured), 0 "
+                                             "(none) with cell")
     oxley: OxleyConstants = OxleyConstants()
 
     @model_validator(mode="after")
