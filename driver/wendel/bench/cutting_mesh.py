@@ -196,8 +196,13 @@ def cutting_steady_bench(quick: bool, workdir: Path) -> list[dict]:
 @register("cutting-steady-fbar")
 def cutting_steady_fbar_bench(quick: bool, workdir: Path) -> list[dict]:
     """``cutting-steady`` with F-bar (``cutting.volumetric = "fbar"``): the same 1.2 mm cut at edge r/2, its
-    own folder and rows (an hour or more on one core; ``--quick``: 400 um)."""
-    return _steady(quick, workdir, "fbar")
+    own folder and rows (an hour or more on one core; ``--quick``: 400 um). ``WENDEL_BENCH_REMESH_EVERY``: remesh
+    after that many increments instead of the scene's 8 (folder ``r2-long-remeshN``; session 14: 6 reaches 1.2 mm)."""
+    import os
+    every = os.environ.get("WENDEL_BENCH_REMESH_EVERY")
+    if every is not None and not (every.isdigit() and 1 <= int(every) <= 100):
+        raise ValueError(f"WENDEL_BENCH_REMESH_EVERY = {every!r}: a whole number of increments from 1 to 100")
+    return _steady(quick, workdir, "fbar", remesh_every=int(every) if every else None)
 
 
 @register("cutting-long")
