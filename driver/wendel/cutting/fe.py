@@ -131,7 +131,6 @@ def fe_scene(scene, travel: float = 1.0) -> Scene:
     steps = scene.loading.steps
     every = c.remesh_every
     # the re-equilibration after a remesh is an increment too: the k-th remesh follows increment k (every + 1) - 1
-    # (a step cut shifts the later ones by one increment)
     # (a step cut shifts the later ones by one increment, and adds one: the list runs on to 3 times the steps, or
     # a cut with many step cuts ran out of scheduled remeshes at 70 % of its travel, measured at edge size r/4)
     at = [k * (every + 1) - 1 for k in range(1, 3 * steps // every + 1)] if every else []

@@ -32,7 +32,21 @@ import heapq
 
 import numpy as np
 
-__all__ = ["smooth", "target_size"]
+__all__ = ["indicator_size", "smooth", "target_size"]
+
+
+def indicator_size(h: float, h_min: float, size_indicator, n: int) -> np.ndarray:
+    """The size the nodal ``size_indicator`` asks for at each of the ``n`` nodes: ``h`` where it is 0, ``h_min``
+    at its maximum, linear in between (``h`` everywhere when its maximum is not positive); the remesher's
+    PostView field (:func:`wendel.remesh.mesher.remesh`).
+
+    >>> indicator_size(4.0, 1.0, [0.0, 1.0, 2.0], 3).tolist()
+    [4.0, 2.5, 1.0]
+    """
+    ind = np.asarray(size_indicator, dtype=float).reshape(n)
+    top = ind.max() if n else 0.0
+    t = np.clip(ind / top, 0.0, 1.0) if top > 0 else np.zeros(n)
+    return h + (h_min - h) * t
 
 
 def target_size(points: np.ndarray, h: float, size_indicator=None, h_min: float | None = None,
@@ -48,11 +62,7 @@ def target_size(points: np.ndarray, h: float, size_indicator=None, h_min: float 
     points = np.asarray(points, dtype=float)
     s = np.full(len(points), float(h))
     if size_indicator is not None:
-        ind = np.asarray(size_indicator, dtype=float).reshape(len(points))
-        top = ind.max() if len(ind) else 0.0
-        if top > 0:
-            hm = h / 4 if h_min is None else h_min
-            s = np.minimum(s, h + (hm - h) * np.clip(ind / top, 0.0, 1.0))
+        s = np.minimum(s, indicator_size(h, h / 4 if h_min is None else h_min, size_indicator, len(points)))
     for z in zones or []:
         lo, hi = (np.asarray(c, dtype=float) for c in z["box"])
         d = len(lo)

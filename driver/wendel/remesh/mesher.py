@@ -300,10 +300,7 @@ def remesh(points_deformed, mesh_in_path, out_path, h, size_indicator=None, h_mi
         else:
             fields, smallest = [], h
             if size_indicator is not None:
-                ind = np.asarray(size_indicator, dtype=float).reshape(n)
-                top = ind.max()
-                t = np.clip(ind / top, 0.0, 1.0) if top > 0 else np.zeros(n)
-                view = _size_view(gmsh, pts, cells, h + (h_min - h) * t)
+                view = _size_view(gmsh, pts, cells, features.indicator_size(h, h_min, size_indicator, n))
                 f = gmsh.model.mesh.field.add("PostView")
                 gmsh.model.mesh.field.setNumber(f, "ViewTag", view)
                 fields.append(f)
