@@ -78,3 +78,20 @@ def test_bad_zones_are_refused_with_the_key(tmp_path):
         fe["remesh"]["zones_follow"] = "tool"
         fe["contact"]["path"] = None
         type(fe_scene(load(STEEL))).model_validate(fe)
+
+
+@pytest.mark.parametrize("name, var, value, words", [
+    ("cutting-long", "WENDEL_BENCH_CUT_MM", "0.5",
+     "WENDEL_BENCH_CUT_MM = 0.5: a length of cut in mm above 1.2 (cutting-steady's) and up to 20"),
+    ("cutting-steady-fbar", "WENDEL_BENCH_REMESH_EVERY", "six",
+     "WENDEL_BENCH_REMESH_EVERY = 'six': a whole number of increments from 1 to 100"),
+])
+def test_the_long_cut_benches_refuse_a_bad_setting_by_name_before_cutting(tmp_path, monkeypatch, name, var, value,
+                                                                           words):
+    from wendel.bench import BENCHES, _load_plugins
+    _load_plugins()
+    monkeypatch.setenv(var, value)
+    with pytest.raises(ValueError) as err:
+        BENCHES[name](False, tmp_path)
+    assert str(err.value) == words
+    assert not any(tmp_path.iterdir())          # nothing cut
