@@ -197,12 +197,28 @@ def cutting_steady_bench(quick: bool, workdir: Path) -> list[dict]:
 def cutting_steady_fbar_bench(quick: bool, workdir: Path) -> list[dict]:
     """``cutting-steady`` with F-bar (``cutting.volumetric = "fbar"``): the same 1.2 mm cut at edge r/2, its
     own folder and rows (an hour or more on one core; ``--quick``: 400 um). ``WENDEL_BENCH_REMESH_EVERY``: remesh
-    after that many increments instead of the scene's 8 (folder ``r2-long-remeshN``; session 14: 6 reaches 1.2 mm)."""
+    after that many increments instead of the scene's 8 (folder ``r2-long-remeshN``; session 14: 6 reaches 1.2 mm);
+    ``WENDEL_BENCH_CUT_MM``: a longer cut [mm] on a block 1.4 mm longer, as ``cutting-long`` (folder
+    ``r2-fbar-<um>um[-remeshN]``, with ``cutting-long``'s means over each 150 um and the last 1.5 mm)."""
     import os
     every = os.environ.get("WENDEL_BENCH_REMESH_EVERY")
     if every is not None and not (every.isdigit() and 1 <= int(every) <= 100):
         raise ValueError(f"WENDEL_BENCH_REMESH_EVERY = {every!r}: a whole number of increments from 1 to 100")
-    return _steady(quick, workdir, "fbar", remesh_every=int(every) if every else None)
+    every = int(every) if every else None
+    if "WENDEL_BENCH_CUT_MM" not in os.environ:
+        return _steady(quick, workdir, "fbar", remesh_every=every)
+    mm = _cut_mm()
+    return _steady(quick, workdir, "fbar", remesh_every=every, length=mm * 1e-3, block=(mm + 1.4) * 1e-3,
+                   folder=f"r2-fbar-{mm * 1e3:.0f}um" + (f"-remesh{every}" if every else ""))
+
+
+def _cut_mm() -> float:
+    """``WENDEL_BENCH_CUT_MM`` (default 2.4) [mm], refused by name outside (1.2, 20]."""
+    import os
+    mm = float(os.environ.get("WENDEL_BENCH_CUT_MM", "2.4"))
+    if not 1.2 < mm <= 20.0:
+        raise ValueError(f"WENDEL_BENCH_CUT_MM = {mm}: a length of cut in mm above 1.2 (cutting-steady's) and up to 20")
+    return mm
 
 
 @register("cutting-long")
@@ -211,10 +227,7 @@ def cutting_long_bench(quick: bool, workdir: Path) -> list[dict]:
     whether the forces settle after the 1.2 mm, with the means over each 150 um of travel (``bin`` rows) and
     over the last 1.5 mm (``mean_*`` in the last row). ``WENDEL_BENCH_CUT_MM``: another length [mm] (the block 1.4 mm
     longer, its own folder). ``--quick``: the 400 um of ``cutting-steady --quick``."""
-    import os
-    mm = float(os.environ.get("WENDEL_BENCH_CUT_MM", "2.4"))
-    if not 1.2 < mm <= 20.0:
-        raise ValueError(f"WENDEL_BENCH_CUT_MM = {mm}: a length of cut in mm above 1.2 (cutting-steady's) and up to 20")
+    mm = _cut_mm()
     return _steady(quick, workdir, "cell", length=mm * 1e-3, block=(mm + 1.4) * 1e-3, folder=f"r2-{mm * 1e3:.0f}um")
 
 
