@@ -83,6 +83,8 @@ def test_bad_zones_are_refused_with_the_key(tmp_path):
 @pytest.mark.parametrize("name, var, value, words", [
     ("cutting-long", "WENDEL_BENCH_CUT_MM", "0.5",
      "WENDEL_BENCH_CUT_MM = 0.5: a length of cut in mm above 1.2 (cutting-steady's) and up to 20"),
+    ("cutting-ti", "WENDEL_BENCH_CUT_MM", "0.1",
+     "WENDEL_BENCH_CUT_MM = 0.1: a length of cut in mm from 0.4 (the scene's) to 20"),
     ("cutting-steady-fbar", "WENDEL_BENCH_CUT_MM", "25",
      "WENDEL_BENCH_CUT_MM = 25.0: a length of cut in mm above 1.2 (cutting-steady's) and up to 20"),
     ("cutting-steady-fbar", "WENDEL_BENCH_REMESH_EVERY", "six",

@@ -116,17 +116,38 @@ def cutting_heat_bench(quick: bool, workdir: Path) -> list[dict]:
 def cutting_ti_bench(quick: bool, workdir: Path) -> list[dict]:
     """The titanium scene (``workflows/cutting-ti6al4v.toml``, adiabatic as written) on the graded mesh at edge size
     r/2 (5 um), cut 400 um (the scene's whole cut; ``--quick`` 100 um): whether it runs, the remesh-cycle means of
-    the forces and the chip thickness over the last 160 um, beside Oxley (about 10 minutes)."""
+    the forces and the chip thickness over the last 160 um, beside Oxley (about 10 minutes).
+    ``WENDEL_BENCH_CUT_MM``: a longer cut [mm] (0.4 to 20) on a block 0.6 mm longer than the cut (folder
+    ``ti-r2-<um>um``), with the steady-state detector's spreads and drifts over the last h (``cutting-steady``'s)."""
+    import os
+
     from ..cutting.scene import predict
     from ..scene import load
     path = WORKFLOWS / "cutting-ti6al4v.toml"
     scene = load(path)
+    mm = os.environ.get("WENDEL_BENCH_CUT_MM")
+    if mm is not None:
+        if not 0.4 <= float(mm) <= 20.0:
+            raise ValueError(f"WENDEL_BENCH_CUT_MM = {float(mm)}: a length of cut in mm from 0.4 (the scene's) to 20")
+        scene.cutting.cut_length = float(mm) * 1e-3
+        scene.loading.steps = round(scene.cutting.cut_length / 5e-6)
+        scene.geometry.model_extra["length"] = scene.cutting.cut_length + 0.6e-3
     if quick:
         scene.cutting.cut_length *= 20 / scene.loading.steps
         scene.loading.steps = 20
     scene.cutting.edge_size = scene.cutting.edge_radius / 2
     workdir.mkdir(parents=True, exist_ok=True)
-    row = _case("adiabatic", quick, workdir, scene=scene, scene_path=path, name="ti-r2")
+    name = "ti-r2" if mm is None or quick else f"ti-r2-{float(mm) * 1e3:.0f}um"
+    row = _case("adiabatic", quick, workdir, scene=scene, scene_path=path, name=name)
+    if mm is not None and not quick:
+        import csv
+
+        from ..cutting.fe_steady import steady
+        cut = [{k: float(v) for k, v in r.items()} for r in csv.DictReader((workdir / name / "cutting.csv").open())]
+        st = steady(cut, scene.cutting.uncut_thickness)
+        row["steady_from_um"] = st["cycles"]["start_m"] * 1e6 if st["cycles"] else None
+        row.update({f"spread_{k}": v for k, v in st["last_window_spreads"]["cycles"].items()})
+        row.update({f"drift_{k}": v for k, v in st["last_window_trends"]["cycles"].items()})
     ox = predict(scene)
     return [row, {"case": "Oxley (sharp tool)", "Fc_last": ox.Fc, "Ft_last": ox.Ft, "chip_last": ox.chip_thickness * 1e6,
                   "T_primary_cycles_C": ox.T_AB - 273.15, "T_secondary_cycles_C": ox.T_int - 273.15}]
