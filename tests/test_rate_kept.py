@@ -74,3 +74,31 @@ def test_the_re_equilibration_keeps_the_rate_factor(tmp_path, scene_file):
     assert np.allclose(rf, factor, rtol=1e-9)
     remeshed = json.loads((root / "summary.json").read_text())["remeshes"][0]
     assert remeshed["after_increment"] == k
+
+
+def test_an_adiabatic_re_equilibration_makes_no_heat(tmp_path):
+    """The steel cut (adiabatic, timed) at smoke size remeshed every 2 increments: the re-equilibrations' plastic
+    flow (the transfer's out-of-balance) heats nothing, so the heat ledger stands still across them, and it
+    still balances; the increments with time heat."""
+    from wendel.cutting.fe_run import run_cut
+    from wendel.scene import load
+
+    from conftest import WORKFLOWS
+    steel = WORKFLOWS / "cutting-aisi1045.toml"
+    scene = load(steel, smoke=True)
+    scene.geometry.model_extra["length"] = 1.2e-3     # m: a shorter block (the cut is 30 um)
+    scene.cutting.cut_length = 0.03e-3
+    scene.loading.steps = 6
+    scene.cutting.remesh_every = 2
+    assert scene.thermal.coupling == "adiabatic"
+    root = run_cut(scene, steel, tmp_path / "cut", smoke=False, progress=lambda *_: None, frames=False)
+    rows = list(csv.DictReader((root / "history.csv").open()))
+    reeq = [k for k, r in enumerate(rows) if r["reequilibration"] == "1"]
+    assert len(reeq) == 2
+    for k in reeq:
+        for key in ("heat_plastic", "plastic_work"):
+            assert float(rows[k][key]) == float(rows[k - 1][key])
+    timed = [float(rows[k][key]) - float(rows[k - 1][key]) for k in range(1, len(rows)) if k not in reeq
+             for key in ("heat_plastic",)]
+    assert min(timed) > 0
+    assert all(float(r["energy_balance_error"]) < 1e-9 for r in rows)
