@@ -257,6 +257,7 @@ class Process:
                                          files.root / mesh_rel, files.root / state_rel, self.g.h, self.h_bore, "",
                                          axisymmetric=self.axi, make_mesh=make_mesh, deformed=False)
             mesh = built["mesh"]
+            rep["remesh_seconds"] += self.look.unbooked()      # waited for after the launch (wendel.loop.lookahead)
             if self.block.transfer == "conservative":
                 self.conserve_heat(old_mesh, old_inc, mesh, files.root / state_rel, rep)
             # Small strain on nested bodies: the displacement reached is the state (its strain is compatible on

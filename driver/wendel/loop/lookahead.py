@@ -30,6 +30,7 @@ class Lookahead:
         self.seconds = 0.0                 # spent in the threads (beside the launches; the mesh worker's wait in it)
         self.waited = 0.0                  # the driver's wait for them after the launches
         self.taken = 0                     # next meshes taken from the worker and read here
+        self._booked = 0.0
 
     def start(self, proc, k: int) -> None:
         """Beside the launch that ends before step ``k`` (0-based index into ``proc.steps``; the cooling when
@@ -48,6 +49,11 @@ class Lookahead:
             self.thread.join()
             self.waited += time.perf_counter() - t0
             self.thread = None
+
+    def unbooked(self) -> float:
+        """The driver's wait since the last call (the remesh report books it: mostly the mesh worker's gmsh)."""
+        booked, self._booked = self._booked, self.waited
+        return self.waited - booked
 
     def mesh(self, path: Path) -> dict | None:
         self.join()
