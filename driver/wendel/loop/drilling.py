@@ -195,10 +195,11 @@ class Process:
         pts, _, cells, _, facets, tags = mesher.read_mesh(path)
         return {"points": pts, "cells": cells, "facets": facets, "tags": tags}
 
-    def submit_bodies(self, k: int) -> None:
-        """The bodies of steps ``k`` and ``k + 1`` (0-based) to the mesh worker, where the tip moves: two ahead,
-        as a 3D body (0.5-0.9 s of gmsh) takes longer than a removal step's launch."""
-        for j in (k, k + 1):
+    def submit_bodies(self, k: int, n: int = 2) -> None:
+        """The bodies of steps ``k`` to ``k + n - 1`` (0-based) to the mesh worker, where the tip moves (a path
+        asked for already is not asked again): ahead, as a 3D body (0.5-0.9 s of gmsh here) takes longer than a
+        removal step's launch."""
+        for j in range(k, k + n):
             if j < len(self.steps) and self.steps[j].depth != (self.steps[j - 1].depth if j else self.depth_prev):
                 kind, kwargs = self.body(self.steps[j].depth)
                 self.builder.submit(kind, self.files.root / f"meshes/step-{j + 1:03d}.msh", kwargs)
