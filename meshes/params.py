@@ -103,7 +103,7 @@ HELP = {
     "optimize": "3D: gmsh's Netgen optimization of the tetrahedra (false: meshing about 6x faster, the worst "
                 "element about half as good; another mesh, so other results at the discretization level)",
     "optimize_threshold": "3D: gmsh's own optimizer (in every 3D mesh) reworks the tetrahedra of quality (gamma) "
-                          "below it: 0.3 is gmsh's default; 0.6 without Netgen meshes hertz-force-3d 3-4x faster "
+                          "below it: 0.3 is gmsh's default; 0.6 without Netgen meshes hertz-force-3d 2-4x faster "
                           "than Netgen (`wendel bench gmsh3d`; another mesh)",
 }
 
