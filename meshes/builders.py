@@ -136,9 +136,10 @@ ALGORITHMS_3D = {"delaunay": 1, "hxt": 10}
 
 
 def _write(gmsh, path: Path, dimension: int, boundaries: list[str], optimize: bool = True,
-           algorithm: str = "delaunay") -> Built:
+           algorithm: str = "delaunay", optimize_threshold: float = 0.3) -> Built:
     if dimension == 3:
         gmsh.option.setNumber("Mesh.Algorithm3D", ALGORITHMS_3D[algorithm])
+        gmsh.option.setNumber("Mesh.OptimizeThreshold", optimize_threshold)   # gmsh's own pass, in generate(3)
     gmsh.model.mesh.generate(dimension)
     if dimension == 3 and optimize:
         gmsh.model.mesh.optimize("Netgen")
@@ -201,12 +202,13 @@ def rectangle(path: Path, x=(0.0, 1.0), y=(0.0, 1.0), h=0.1, refine=None, struct
 
 @register("box", ["left", "right", "front", "back", "bottom", "top"])
 def box(path: Path, x=(0.0, 1.0), y=(0.0, 1.0), z=(0.0, 1.0), h=0.1, refine=None, optimize=True,
-        algorithm="delaunay") -> Built:
+        algorithm="delaunay", optimize_threshold=0.3) -> Built:
     """A box [x0, x1] x [y0, y1] x [z0, z1] (m) with boundaries left, right, front, back, bottom, top.
 
     ``optimize = False`` skips gmsh's Netgen optimization of the tetrahedra (most of the 3D meshing time:
     `wendel bench gmsh3d`): another, faster mesh with a worse worst element. ``algorithm = "hxt"`` meshes the
-    volume with gmsh's HXT instead of its Delaunay (faster again: `wendel bench gmsh3d`)."""
+    volume with gmsh's HXT instead of its Delaunay (faster again: `wendel bench gmsh3d`). ``optimize_threshold``:
+    gmsh's own optimizer reworks the tetrahedra of quality below it (0.3, gmsh's default; hertz-force-3d: 0.6)."""
     names = ["left", "right", "front", "back", "bottom", "top"]
     with _Session("box") as gmsh:
         occ = gmsh.model.occ
@@ -214,7 +216,8 @@ def box(path: Path, x=(0.0, 1.0), y=(0.0, 1.0), z=(0.0, 1.0), h=0.1, refine=None
         occ.synchronize()
         _size_field(gmsh, h, refine)
         _tag_boxes(gmsh, 3, (x[0], y[0], z[0]), (x[1], y[1], z[1]), names)
-        return _write(gmsh, path, 3, names, optimize=optimize, algorithm=algorithm)
+        return _write(gmsh, path, 3, names, optimize=optimize, algorithm=algorithm,
+                      optimize_threshold=optimize_threshold)
 
 
 @register("ring", lambda quarter=True, **_: ["inner", "outer"] + (["symmetry_x", "symmetry_y"] if quarter else []))

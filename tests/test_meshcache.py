@@ -126,10 +126,11 @@ def test_the_mesh_cache_option_of_wendel_run(tmp_path, monkeypatch, capsys):
 
 
 @pytest.mark.parametrize("variant", [{"optimize": False}, {"optimize": False, "algorithm": "hxt"},
-                                     {"algorithm": "hxt"}])
+                                     {"algorithm": "hxt"}, {"optimize": False, "optimize_threshold": 0.6}])
 def test_box_without_netgen_is_another_valid_mesh_under_another_key(variant, tmp_path, monkeypatch):
     """geometry.optimize = false and/or algorithm = "hxt" (box): gmsh's tetrahedra without the Netgen
-    optimization, or by HXT instead of Delaunay: the same boundaries, another mesh (so another cache key),
+    optimization, or by HXT instead of Delaunay, or gmsh's own optimizer up to another quality
+    (optimize_threshold, hertz-force-3d's mesh): the same boundaries, another mesh (so another cache key),
     every tetrahedron of positive volume; the same keywords give the same file again (HXT on one thread)."""
     monkeypatch.setenv(ENV, str(tmp_path / "cache"))
     opt = build("box", tmp_path / "opt.msh", **BOX)

@@ -1,6 +1,8 @@
 """Time outside the solve of the drilling loop (issue 20): each launch started while the driver prepares it
 (wendel.prestart), the next removal step's mesh built while FreeFEM solves (wendel.loop.ahead), each mesh
-file parsed once (wendel.results.meshfile); the same run as without them (WENDEL_PRESTART=0)."""
+file parsed once (wendel.results.meshfile); the same run as without them (WENDEL_PRESTART=0). The point sets
+located and the next mesh read beside the solve (wendel.loop.lookahead): the same files, bit for bit, as
+without (WENDEL_LOOKAHEAD=0)."""
 
 from __future__ import annotations
 
@@ -70,6 +72,38 @@ def test_drilling_with_launches_and_meshes_started_ahead_gives_the_same_run(tmp_
     import matplotlib.image
     img = matplotlib.image.imread(ahead / "probes.png")
     assert img[..., :3].std() > 0.01            # not blank
+
+
+def test_drilling_with_the_lookahead_writes_the_same_files_bit_for_bit(tmp_path, monkeypatch):
+    """drilling-3d (smoke): the next mesh taken from the worker and read, and the probes, the removed slice,
+    the new nodes and the new quadrature points located in a thread while FreeFEM solves; the driver's own
+    calls then get those answers (wendel.remesh.transfer.locate keeps them by the bytes of mesh and points).
+    Every file the run writes but its clocks is the one of the run without the thread."""
+    from wendel.loop import run
+
+    look = run(WORKFLOWS / "drilling-3d.toml", smoke=True, out=tmp_path / "look", png=False, progress=lambda *_: None)
+    monkeypatch.setenv("WENDEL_LOOKAHEAD", "0")
+    plain = run(WORKFLOWS / "drilling-3d.toml", smoke=True, out=tmp_path / "plain", png=False,
+                progress=lambda *_: None)
+    s1, s2 = (json.loads((r / "summary.json").read_text()) for r in (look, plain))
+    steps = s1["drilling"]["process"]["removal_steps"]
+    assert steps >= 2 and s1["drilling"]["remesh"]["meshes_read_beside"] == steps - 1
+    assert s2["drilling"]["remesh"]["meshes_read_beside"] == 0
+    clocks = ("time", "seconds", "wall", "share", "lookahead", "meshes_read_beside")
+    files = [f.relative_to(look) for f in sorted(look.rglob("*")) if f.is_file()
+             and f.suffix in (".txt", ".vtu", ".msh", ".csv") and not f.name.startswith(("newton", "history", "drilling-steps"))]   # clocks in them
+    assert len(files) > 50
+    for f in files:
+        assert (look / f).read_bytes() == (plain / f).read_bytes(), f
+
+    def strip(x):
+        if isinstance(x, dict):
+            return {k: strip(v) for k, v in x.items() if not any(c in k for c in clocks)}
+        return [strip(v) for v in x] if isinstance(x, list) else x
+
+    d1, d2 = (json.loads((r / "drilling.json").read_text()) for r in (look, plain))
+    assert strip(d1) == strip(d2)
+    assert _records(look) == _records(plain)
 
 
 def test_a_launch_started_ahead_with_other_options_is_stopped_and_the_asked_one_runs(tmp_path):

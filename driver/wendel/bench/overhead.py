@@ -19,6 +19,8 @@ scene with that checkout's driver too (same Python, alternating, one run each); 
 (``tree``: ``base`` or ``this``) and ``same_as_base`` says whether both gave the same fingerprints
 (:func:`same_fingerprints`). ``python -m wendel.bench.overhead RUN.json ...`` prints the table of saved runs
 (:func:`side_by_side`). An older checkout's summary.json is read with today's accounting (:func:`shares`).
+Both trees run this tree's scene file, unless ``WENDEL_BENCH_OWN_SCENES=1``: then the base runs its own
+``workflows/`` file of the same name (a change of a scene's keys, e.g. hertz-force-3d's mesh options).
 """
 
 from __future__ import annotations
@@ -55,6 +57,13 @@ except ImportError:
     leave = sys.exit
 leave(0)
 """
+
+
+def scene_for(tree: Path | None, scene: Path) -> Path:
+    """The scene file a tree runs: this tree's, or with ``WENDEL_BENCH_OWN_SCENES=1`` the base tree's own file
+    of that name where it has one."""
+    own = tree / "workflows" / scene.name if tree else scene
+    return own if os.environ.get("WENDEL_BENCH_OWN_SCENES") == "1" and own.is_file() else scene
 
 
 def run_once(scene: Path, out: Path, smoke: bool, scale: float | None, tree: Path | None = None) -> dict:
@@ -182,7 +191,7 @@ def overhead(quick: bool, workdir: Path) -> list[dict]:
             continue
         for tree in trees:
             out = workdir / scene.stem / ("base" if tree else "this")
-            row = run_once(scene, out, quick, SCALE.get(scene.name), tree)
+            row = run_once(scene_for(tree, scene), out, quick, SCALE.get(scene.name), tree)
             if "process_wall" in row and "wall" in row:
                 row["outside_process"] = 1.0 - row["solve"] / row["process_wall"]
                 row["python"] = max(row["process_wall"] - row["wall"], 0.0)

@@ -51,10 +51,12 @@ class Builder:
         self.proc: subprocess.Popen | None = None
         self.pending: list[str] = []            # paths asked for, in order (the worker answers in order)
         self.taken = 0                          # meshes built ahead and used
+        self.asked: set[str] = set()            # every path asked for (asked again: nothing to do)
 
     def submit(self, kind: str, path: Path, kwargs: dict) -> None:
-        if os.environ.get("WENDEL_PRESTART", "1") == "0":
+        if os.environ.get("WENDEL_PRESTART", "1") == "0" or str(path) in self.asked:
             return
+        self.asked.add(str(path))
         try:
             if self.proc is None:
                 env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p))   # the driver's code

@@ -61,6 +61,7 @@ from ..results.drilling import bore_profile, plots, write_csv
 from . import drilling_state as kept, launch, overlap
 from .ahead import Builder
 from .checkpoint import RunFiles, State
+from .lookahead import Lookahead
 from .quasistatic import accept
 from .steps import StepCutError
 
@@ -138,6 +139,7 @@ def run(scene, scene_path: Path, out: Path, smoke: bool = False, progress=print,
             proc.cool(cooling)
             kept.save(proc, len(steps), True)
     finally:
+        proc.look.join()
         prestart.abandon(proc.ahead)        # a launch started for a step that did not come
         proc.builder.close()
     summary = report.write_summary(files.root, work, state, dim)
@@ -168,6 +170,8 @@ class Process:
         self.steps, self.cooling = [], []
         self.ahead = None                    # the next launch, started while the driver prepares it (prestart)
         self.builder = Builder()             # the next removal step's mesh, built while FreeFEM solves
+        self.look = Lookahead()              # and what the driver needs of it, found beside the solve
+        self.mesh = None
 
     # ---- the geometry of the workpiece
     def body(self, depth: float) -> tuple[str, dict]:
@@ -178,6 +182,9 @@ class Process:
                           h=self.g.h, h_bore=self.h_bore, grade=self.block.grade, **params)
 
     def build(self, depth: float, path: Path) -> dict:
+        ahead = self.look.mesh(path)             # taken and read beside the last solve (wendel.loop.lookahead)
+        if ahead is not None:
+            return ahead
         if not self.builder.take(path):          # not built ahead (wendel.loop.ahead): here
             kind, kwargs = self.body(depth)
             with remeshing._quiet_stdout():
@@ -187,6 +194,15 @@ class Process:
                     geometry.drilled(path, kind, **kwargs)
         pts, _, cells, _, facets, tags = mesher.read_mesh(path)
         return {"points": pts, "cells": cells, "facets": facets, "tags": tags}
+
+    def submit_bodies(self, k: int, n: int = 2) -> None:
+        """The bodies of steps ``k`` to ``k + n - 1`` (0-based) to the mesh worker, where the tip moves (a path
+        asked for already is not asked again): ahead, as a 3D body (0.5-0.9 s of gmsh here) takes longer than a
+        removal step's launch."""
+        for j in range(k, k + n):
+            if j < len(self.steps) and self.steps[j].depth != (self.steps[j - 1].depth if j else self.depth_prev):
+                kind, kwargs = self.body(self.steps[j].depth)
+                self.builder.submit(kind, self.files.root / f"meshes/step-{j + 1:03d}.msh", kwargs)
 
     def areas(self, mesh: dict) -> dict[str, float]:
         p, f, tags = mesh["points"], mesh["facets"], mesh["tags"]
@@ -212,6 +228,7 @@ class Process:
             row.update(chips_heat=0.0, nodes_outside_old_mesh=0, remesh_seconds=0.0, transfer_seconds=0.0,
                        chips_seconds=0.0)
         elif not state.segments:
+            self.submit_bodies(k)              # the worker starts on the next bodies while the driver meshes this one
             mesh = self.build(step.depth, files.root / mesh_rel)
             seg = {"first": k, "mesh": mesh_rel, "ubase": None, "eps0": None}
             row.update(chips_heat=0.0, energy_after_transfer=0.0, nodes_outside_old_mesh=0,
@@ -228,7 +245,8 @@ class Process:
 
             def make_mesh(xd, mesh_old, mesh_new, h, size_indicator=None, h_min=None):
                 built["mesh"] = self.build(step.depth, Path(mesh_new))
-                q = quality.mesh_quality(built["mesh"]["points"], built["mesh"]["cells"])
+                q = self.look.quality(Path(mesh_new)) or quality.mesh_quality(built["mesh"]["points"],
+                                                                               built["mesh"]["cells"])
                 pts = built["mesh"]["points"][:, :self.dim]
                 return {"min_sicn": q["min"],
                         "measure_old": float(remeshing.cell_volumes(xd, old_mesh["cells"], self.axi).sum()),
@@ -240,6 +258,7 @@ class Process:
                                          files.root / mesh_rel, files.root / state_rel, self.g.h, self.h_bore, "",
                                          axisymmetric=self.axi, make_mesh=make_mesh, deformed=False)
             mesh = built["mesh"]
+            rep["remesh_seconds"] += self.look.unbooked()      # waited for after the launch (wendel.loop.lookahead)
             if self.block.transfer == "conservative":
                 self.conserve_heat(old_mesh, old_inc, mesh, files.root / state_rel, rep)
             # Small strain on nested bodies: the displacement reached is the state (its strain is compatible on
@@ -326,9 +345,8 @@ class Process:
         ahead, self.ahead = self.ahead, None
         taken, wall = ahead is not None and ahead.options == opts, None
         k = inc0 + len(lfs) - 1                  # the step after this launch's last: its body while FreeFEM solves
-        if k < len(self.steps) and self.steps[k].depth != (self.steps[k - 1].depth if k else self.depth_prev):
-            kind, kwargs = self.body(self.steps[k].depth)
-            self.builder.submit(kind, files.root / f"meshes/step-{k + 1:03d}.msh", kwargs)
+        self.submit_bodies(k)
+        self.look.start(self, k)        # beside the solve: the point sets of this mesh, the next mesh
         # the transfer's scipy (0.5 s) and the plots' imports (0.4-0.6 s) while FreeFEM solves, not before the
         # first launch or at the first remesh and the end
         overlap.preload("scipy.spatial", "scipy.sparse")
@@ -389,6 +407,7 @@ class Process:
 
     # ---- bookkeeping after a launch
     def close_rows(self, rows: list[dict]) -> None:
+        self.look.join()
         first = self.state.last[0] - len(rows) + 1
         for i, row in enumerate(rows):
             inc = first + i
@@ -430,14 +449,17 @@ class Process:
 
     def chips_heat(self, mesh: dict, T: np.ndarray, d0: float, d1: float) -> tuple[float, int]:
         """Heat content int rho c (T - T_0) dV of the slice the drill removes from d0 to d1 (J), on the old mesh."""
-        pts, w = removed_slice_quadrature(d0, d1, self.block.diameter / 2, self.block.point_angle,
-                                          self.g.params.get("height", 0.03), self.axis, n_theta=1 if self.axi else 48)
-        if self.axi:
-            pts = pts[:, [0, 2]]        # (r, 0, z) -> (r, z)
+        pts, w = self.slice_quadrature(d0, d1)
         if len(pts) == 0:
             return 0.0, 0
         vals, outside = transfer.transfer_nodal(mesh["points"], mesh["cells"], T - self.T0, pts)
         return float(self.rho_c * w @ vals), int(outside)
+
+    def slice_quadrature(self, d0: float, d1: float) -> tuple[np.ndarray, np.ndarray]:
+        """Points and weights of :meth:`chips_heat`'s rule (in (r, z): the columns r and z)."""
+        pts, w = removed_slice_quadrature(d0, d1, self.block.diameter / 2, self.block.point_angle,
+                                          self.g.params.get("height", 0.03), self.axis, n_theta=1 if self.axi else 48)
+        return (pts[:, [0, 2]] if self.axi else pts), w          # (r, 0, z) -> (r, z)
 
     @property
     def axis(self) -> tuple[float, float]:
@@ -447,13 +469,17 @@ class Process:
         if not self.block.probes:
             return
         names = [p.name for p in self.block.probes]
-        pos = np.array([p.position for p in self.block.probes], dtype=float)
-        if self.axi:        # a thermocouple at (x, y, z) sits at r = hypot(x, y) of the section
-            pos = np.column_stack([np.hypot(pos[:, 0], pos[:, 1]), pos[:, 2]])
+        pos = self.probe_positions()
         inside = transfer.locate(self.mesh["points"], self.mesh["cells"], pos)[0] >= 0
         vals, _ = transfer.transfer_nodal(self.mesh["points"], self.mesh["cells"], T, pos)
         self.probes.append({"time": row["time"], **{n: float(v) if ok else float("nan")
                                                      for n, v, ok in zip(names, vals, inside)}})
+
+    def probe_positions(self) -> np.ndarray:
+        pos = np.array([p.position for p in self.block.probes], dtype=float)
+        if self.axi:        # a thermocouple at (x, y, z) sits at r = hypot(x, y) of the section
+            pos = np.column_stack([np.hypot(pos[:, 0], pos[:, 1]), pos[:, 2]])
+        return pos
 
     def record_profile(self, inc: int, row: dict, d: Path) -> None:
         """Bore diameter error 2 u_r along the depth, and the stresses of the cells at the wall."""
@@ -494,6 +520,8 @@ class Process:
                        "new_nodes": [r.get("new_nodes", r["mesh_nodes"]) for r in rows if r["kind"] != "cool"],
                        "remesh_transfer_share": shares, "meshes_built_ahead": self.builder.taken,
                        "launches_started_ahead": sum(bool(l.get("prestarted")) for l in self.state.launches),
+                       "lookahead_seconds": self.look.seconds, "lookahead_wait": self.look.waited,
+                       "meshes_read_beside": self.look.taken,
                        "mean_remesh_transfer_share": float(np.mean(shares)) if shares else 0.0,
                        "step_seconds": [r.get("remesh_seconds", 0) + r.get("transfer_seconds", 0)
                                         + r.get("chips_seconds", 0) + r.get("launch_seconds", 0)

@@ -45,7 +45,7 @@ def conservative_transfer(old_points, old_cells, values, new_points, new_cells, 
     dim = new_cells.shape[1] - 1
     bary, w = RULES[dim]
     pts = np.asarray(new_points, dtype=float)[:, :dim]
-    q = np.einsum("qj,cjk->cqk", bary, pts[new_cells]).reshape(-1, dim)
+    q = quadrature_points(pts, new_cells)
     vq, outside = transfer.transfer_nodal(old_points, old_cells, values, q)
     vq = vq.reshape(len(new_cells), len(w))
     vol = cell_volumes(pts, new_cells)
@@ -57,6 +57,13 @@ def conservative_transfer(old_points, old_cells, values, new_points, new_cells, 
     mass = np.bincount(new_cells.ravel(), weights=cell_mass.ravel(), minlength=len(pts))
     load = np.bincount(new_cells.ravel(), weights=contrib.ravel(), minlength=len(pts))
     return load / mass, outside
+
+
+def quadrature_points(new_points, new_cells) -> np.ndarray:
+    """The points of :func:`conservative_transfer`'s rule in every new cell, cell by cell ((m * q, d))."""
+    dim = new_cells.shape[1] - 1
+    pts = np.asarray(new_points, dtype=float)[:, :dim]
+    return np.einsum("qj,cjk->cqk", RULES[dim][0], pts[new_cells]).reshape(-1, dim)
 
 
 def removed_slice_quadrature(d0: float, d1: float, radius: float, point_angle: float, height: float,

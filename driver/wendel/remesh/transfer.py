@@ -139,18 +139,26 @@ _LOCATORS: dict = {}
 """Recent meshes' :class:`_Locator` by the bytes of their points and cells (a few: they are small)."""
 
 
-def _locator(pts, cells, dim) -> _Locator:
+def _digest(a: np.ndarray) -> tuple:
     import hashlib
 
-    key = (pts.shape, cells.shape, hashlib.blake2b(np.ascontiguousarray(pts)).digest()
-           + hashlib.blake2b(np.ascontiguousarray(cells)).digest())
+    return a.shape, a.dtype.str, hashlib.blake2b(np.ascontiguousarray(a)).digest()
+
+
+def _locator(pts, cells, dim) -> tuple[_Locator, tuple]:
+    key = (_digest(pts), _digest(cells))
     loc = _LOCATORS.pop(key, None)
     if loc is None:
         loc = _Locator(pts, cells, dim)
     _LOCATORS[key] = loc                      # the most recent last
     while len(_LOCATORS) > 4:
         del _LOCATORS[next(iter(_LOCATORS))]
-    return loc
+    return loc, key
+
+
+_LOCATED: dict = {}
+"""Recent :func:`locate` answers by mesh, points and tolerance (the drilling loop locates each point set while
+FreeFEM solves, :mod:`wendel.loop.lookahead`, and again after it: the same arrays, not searched twice)."""
 
 
 def locate(old_points, old_cells, new_points, tol=1e-9):
@@ -175,7 +183,11 @@ def locate(old_points, old_cells, new_points, tol=1e-9):
     pts, cells, dim = _as_arrays(old_points, old_cells)
     q = np.asarray(new_points, dtype=float)
     q = q.reshape(-1, dim) if q.ndim == 1 else q[:, :dim]
-    loc = _locator(pts, cells, dim)
+    loc, key = _locator(pts, cells, dim)
+    key = (key, _digest(q), tol)
+    if key in _LOCATED:
+        cell, bary = _LOCATED[key]
+        return cell.copy(), bary.copy()
     inv, x0 = loc.inv, loc.x0
     cell = np.full(len(q), -1, dtype=np.int64)
     bary = np.zeros((len(q), dim + 1))
@@ -211,6 +223,9 @@ def locate(old_points, old_cells, new_points, tol=1e-9):
     found = cell >= 0
     b = np.clip(bary[found], 0.0, None)
     bary[found] = b / b.sum(axis=1, keepdims=True)
+    _LOCATED[key] = cell.copy(), bary.copy()
+    while len(_LOCATED) > 12:
+        del _LOCATED[next(iter(_LOCATED))]
     return cell, bary
 
 
