@@ -141,6 +141,8 @@ def fe_scene(scene, travel: float = 1.0) -> Scene:
     smooth = c.smooth_features if c.smooth_features is not None else (SMOOTH_FBAR if c.volumetric == "fbar" else 0.0)
     if smooth > 0:
         remesh["smooth_features"] = smooth
+    if c.snap_to_tool:
+        remesh["snap_to_tool"] = True
     if c.edge_size is not None:      # graded: fine at the edge, coarse far away (size_zones)
         remesh["h"] = FAR * fine * g.h * MM
         remesh["zones"] = size_zones(c, tool["tip"], fine * g.h * MM, (every or 1) * cut / steps)

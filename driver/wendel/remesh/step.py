@@ -32,6 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from .again import AGAIN, made_or_failed
+from .snap import tool_at, zones_at       # where the tool stands at a remesh (numpy only)
 from . import quality       # mesher (meshio, gmsh) and transfer (scipy) when a run remeshes: a run without
                             # remeshing judges its mesh only and does not pay their imports
 from ..results import vtu
@@ -88,7 +89,7 @@ def remesh_state(inc_dir: Path, mesh_old: Path, ubase_old: np.ndarray | None, di
                  mesh_new: Path, state_new: Path, h: float, h_min: float, indicator: str,
                  mu: float | None = None, axisymmetric: bool = False, make_mesh=None,
                  deformed: bool = True, zones: list[dict] | None = None, algorithm_2d: int | None = None,
-                 smooth_features: float = 0.0) -> dict:
+                 smooth_features: float = 0.0, tool: dict | None = None) -> dict:
     """Mesh the deformed body of increment ``inc_dir`` anew and write the transferred state.
 
     Writes ``mesh_new`` and, in ``state_new``, ``u.node.txt`` (zeros), ``ubase.txt``, ``eps0.txt`` and the
@@ -98,7 +99,9 @@ def remesh_state(inc_dir: Path, mesh_old: Path, ubase_old: np.ndarray | None, di
     ``make_mesh`` replaces :func:`wendel.remesh.mesher.remesh` (same arguments and report keys), e.g. the material
     removal of :mod:`wendel.drilling`; ``deformed = False`` transfers in the reference configuration
     (small strain: the new mesh is made from the original geometry); ``zones``: boxes of finer size
-    (:func:`wendel.remesh.mesher.remesh`); ``smooth_features``: :mod:`wendel.remesh.features`.
+    (:func:`wendel.remesh.mesher.remesh`); ``smooth_features``: :mod:`wendel.remesh.features`; ``tool``: a 2D
+    rigid tool where it stands (``vertices``, ``radii``): new boundary nodes inside it are moved onto its surface
+    (:mod:`wendel.remesh.snap`).
     """
     from . import mesher, transfer
 
@@ -121,12 +124,17 @@ def remesh_state(inc_dir: Path, mesh_old: Path, ubase_old: np.ndarray | None, di
     t1 = time.perf_counter()
     Y, new_cells = vtu.read_mesh(mesh_new, dimension)
     Y = Y[:, :dimension]
+    snapped = {}
+    if tool is not None and dimension == 2 and deformed:
+        from .snap import onto_tool
+        Y, snapped = onto_tool(mesh_new, Y, new_cells, tool)
     state_new.mkdir(parents=True, exist_ok=True)
     report = {"old_nodes": n_old, "old_elements": len(cells), "new_nodes": len(Y), "new_elements": len(new_cells),
               "min_quality_before": before["min"], "inverted_before": before["inverted"],
               "min_quality_after": info["min_sicn"], "measure_old": info["measure_old"],
               "measure_new": info["measure_new"], "remesh_seconds": t1 - t0,
               "boundary_nodes_smoothed": info.get("boundary_nodes_smoothed", 0)}
+    report.update(snapped)
     # Every field goes through one point location: nodal fields as they are, cell fields recovered
     # to nodes (volume-weighted, integral kept), all stacked, interpolated once, split again.
     utot = u + (ubase_old if ubase_old is not None else 0.0)
@@ -248,17 +256,6 @@ def finish_report(report: dict, reeq_dir: Path, path: Path) -> dict:
     return report
 
 
-def zones_at(r, inc_dir: Path) -> list[dict]:
-    """The size zones of ``remesh`` (``r``) for the remesh after increment ``inc_dir``: as written, or moved by
-    the tool's placement (``tool_x``, ``tool_y``(, ``tool_z``) of its record.json) when they follow the tool."""
-    shift = np.zeros(3)
-    if r.zones and r.zones_follow == "tool":
-        rec = json.loads((inc_dir / "record.json").read_text())
-        shift = np.array([float(rec.get(f"tool_{a}", 0.0)) for a in "xyz"])
-    return [{"box": [[c + d for c, d in zip(corner, shift)] for corner in z.box], "h": z.h, "thickness": z.thickness}
-            for z in r.zones]
-
-
 def maybe_remesh(scene, files, state, dimension: int, progress, again: int = 0) -> None:
     """The loop's remesh step: after the last accepted increment, remesh when its deformed mesh is too poor
     (or the scene asks); the next launch re-equilibrates the transferred state at the same load factor.
@@ -290,7 +287,8 @@ def maybe_remesh(scene, files, state, dimension: int, progress, again: int = 0) 
         files.fem / f"inc-{inc:04d}", files.root / seg["mesh"], ubase_old, dimension, files.root / mesh_new,
         files.root / state_dir, h, r.h_min or h / 3, r.indicator, mu=scene.material.E / (2 * (1 + scene.material.nu)),
         axisymmetric=scene.elasticity.plane == "axisymmetric", zones=zones_at(r, files.fem / f"inc-{inc:04d}"),
-        algorithm_2d=AGAIN[again - 1] if again else None, smooth_features=r.smooth_features), k, inc, lf, q, files.root)
+        algorithm_2d=AGAIN[again - 1] if again else None, smooth_features=r.smooth_features,
+        tool=tool_at(scene, files.fem / f"inc-{inc:04d}") if r.snap_to_tool else None), k, inc, lf, q, files.root)
     rep.update({"remesh": k, "after_increment": inc, "load_factor": lf, "dimension": dimension,
                 "algorithm_2d_tries": again})
     state.remeshes.append(rep)

@@ -295,6 +295,9 @@ class Remesh(Strict):
                                    "whose neighbours are closer than the local target size and that stand less than "
                                    "this share of it off their chord (wrinkles the new mesh cannot resolve; "
                                    "wendel.remesh.features) [1]; 0: keep every node")
+    snap_to_tool: bool = Field(False, description="2D with a polygon tool (contact.tool): the new mesh's boundary "
+                               "nodes that fall inside the tool (on old boundary edges that cut its rounded corner) "
+                               "are moved onto its surface before the transfer (wendel.remesh.snap)")
     zones_follow: Literal["body", "tool"] = Field("body", description="body: the zones stand where they are "
                                                   "written; tool: they move with contact.path (written for "
                                                   "the tool at load factor 0)")

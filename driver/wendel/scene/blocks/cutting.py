@@ -103,6 +103,9 @@ class Cutting(BaseModel):
                                              "[1]; default 0.25 with volumetric = fbar (its chip front folds into "
                                              "notches a few um deep: fresh meshes of quality 0.09, measured), 0 "
                                              "(none) with cell")
+    snap_to_tool: bool = Field(False, description="FE: the remeshes move new boundary nodes that fall inside the "
+                               "tool (on old edges of the machined surface that cut its rounded edge: 1.3-3.4 um "
+                               "deep on the F-bar steel cut, measured) onto its surface, as remesh.snap_to_tool")
     oxley: OxleyConstants = OxleyConstants()
 
     @model_validator(mode="after")
