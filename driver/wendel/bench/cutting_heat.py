@@ -146,6 +146,8 @@ def cutting_ti_bench(quick: bool, workdir: Path) -> list[dict]:
         cut = [{k: float(v) for k, v in r.items()} for r in csv.DictReader((workdir / name / "cutting.csv").open())]
         st = steady(cut, scene.cutting.uncut_thickness)
         row["steady_from_um"] = st["cycles"]["start_m"] * 1e6 if st["cycles"] else None
+        row["filtered_from_um"] = st["filtered"]["start_m"] * 1e6 if st["filtered"] else None
+        row.update({f"fspread_{k}": v for k, v in st["last_window_spreads"]["filtered"].items()})
         row.update({f"spread_{k}": v for k, v in st["last_window_spreads"]["cycles"].items()})
         row.update({f"drift_{k}": v for k, v in st["last_window_trends"]["cycles"].items()})
     ox = predict(scene)

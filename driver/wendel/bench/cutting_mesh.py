@@ -291,8 +291,10 @@ def _steady(quick: bool, workdir: Path, volumetric: str, remesh_every: int | Non
         w = window(rows, 1.5e-3)
         means = {"mean_from_um": w["steady_window_from_m"] * 1e6, "mean_Fc_N": w["steady_Fc_N"],
                  "mean_Ft_N": w["steady_Ft_N"], "mean_chip_um": w["steady_chip_m"] * 1e6}
+    filt = st["filtered"]
     res.append({"travel_um": rows[-1]["tool_travel_m"] * 1e6, "steady_from_um": found["start_m"] * 1e6 if found else None,
-                **means,
+                "filtered_from_um": filt["start_m"] * 1e6 if filt else None, **means,
+                **{f"fspread_{k}": v for k, v in st["last_window_spreads"]["filtered"].items()},
                 **{f"spread_{k}": v for k, v in st["last_window_spreads"]["cycles"].items()},
                 **{f"drift_{k}": v for k, v in st["last_window_trends"]["cycles"].items()},
                 **{f"inc_spread_{k}": v for k, v in st["last_window_spreads"]["raw"].items()},
