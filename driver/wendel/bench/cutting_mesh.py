@@ -189,9 +189,7 @@ def cutting_steady_bench(quick: bool, workdir: Path) -> list[dict]:
     """The middle resolution (edge r/2) cut twice as far as the scene, 1.2 mm (8 h), on a block 2.6 mm long
     (the primary zone stays clear of its far end): whether and where the forces and the chip settle within 2 %
     (:func:`wendel.cutting.fe_steady.steady` on the remesh-cycle means, a window of one h), with the last
-    window's spreads and drifts, and where the running means over one h settle (``filtered``). ``--quick``:
-    400 um. ``WENDEL_BENCH_SNAP=1`` (also for ``cutting-steady-fbar`` and ``cutting-long``): with
-    ``cutting.snap_to_tool`` (folder ``...-snap``)."""
+    window's spreads and drifts. ``--quick``: 400 um."""
     return _steady(quick, workdir, "cell")
 
 
@@ -217,16 +215,10 @@ def cutting_steady_fbar_bench(quick: bool, workdir: Path) -> list[dict]:
 def _snap() -> bool:
     """``WENDEL_BENCH_SNAP=1``: the cut with ``cutting.snap_to_tool`` (folder ``...-snap``); 0 or unset: as the
     scene says."""
-    return _flag("WENDEL_BENCH_SNAP")
-
-
-def _flag(name: str) -> bool:
-    """An on/off setting of the cut benches from the environment: 1 on, 0 or unset off, else refused by name
-    (``WENDEL_BENCH_UNTANGLE=1``: ``cutting.untangle_first_step``, folder ``...-untangle``)."""
     import os
-    v = os.environ.get(name, "0")
+    v = os.environ.get("WENDEL_BENCH_SNAP", "0")
     if v not in ("0", "1"):
-        raise ValueError(f"{name} = {v!r}: 1 (on) or 0 (off)")
+        raise ValueError(f"WENDEL_BENCH_SNAP = {v!r}: 1 (snap the remeshes' boundary nodes out of the tool) or 0")
     return v == "1"
 
 
@@ -262,9 +254,6 @@ def _steady(quick: bool, workdir: Path, volumetric: str, remesh_every: int | Non
     if _snap():
         scene.cutting.snap_to_tool = True
         folder = (folder or ("r2-long" if not remesh_every else f"r2-long-remesh{remesh_every}")) + "-snap"
-    if _flag("WENDEL_BENCH_UNTANGLE"):
-        scene.cutting.untangle_first_step = True
-        folder = (folder or ("r2-long" if not remesh_every else f"r2-long-remesh{remesh_every}")) + "-untangle"
     long = length > 1.2e-3
     length = 0.4e-3 if quick else length
     scene.geometry.model_extra["length"] = block

@@ -174,8 +174,7 @@ def fe_scene(scene, travel: float = 1.0) -> Scene:
         # the return mapping solves it, plasticity.idp's plastAd)
         # predictor: each increment starts from the last one's motion extrapolated (the tool moves steadily; the
         # first guess from u_n met the tool 5 um deep: 30-40 % fewer Newton iterations, measured in session 8)
-        "numerics": {"solver": "direct", "newton_tol": 1e-8, "newton_maxit": 100, "predictor": "extrapolate",
-                     **({"first_step": "untangle"} if c.untangle_first_step else {})},
+        "numerics": {"solver": "direct", "newton_tol": 1e-8, "newton_maxit": 100, "predictor": "extrapolate"},
         "output": {"png": False, "vtu": True},
         "remesh": remesh,
     }

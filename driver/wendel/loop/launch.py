@@ -72,8 +72,6 @@ def options(scene: Scene, files: RunFiles, dimension: int, segment: dict | None 
         opts += ["-solver_forcing", n.forcing]
     if n.predictor == "extrapolate":
         opts += ["-newton_predictor", "1"]     # edp/lib/predictor.idp
-    if n.first_step == "untangle":
-        opts += ["-newton_untangle", "1"]
     if n.solver == "petsc":
         opts += petsc.launch_options(n.petsc.pc, n.petsc.options, n.petsc.reuse)
     if scene.problem != "mechanics":

@@ -202,10 +202,6 @@ class Numerics(Strict):
                                                       "displacement increment scaled to the load step (one Newton "
                                                       "iteration less on a smooth nonlinear path; "
                                                       "edp/lib/predictor.idp)")
-    first_step: Literal["whole", "untangle"] = Field("whole", description="the first Newton step of an increment: "
-                                                     "whole = taken whole (a trial that tangles an updated-Lagrangian "
-                                                     "mesh fails the increment and the step is cut); untangle = "
-                                                     "halved while its trial tangles the mesh")
     timeout: float = Field(3600.0, gt=0, description="wall-time limit of one FreeFEM launch [s]")
     petsc: Petsc = Field(default_factory=Petsc, description="PETSc solver settings (solver = \"petsc\")")
     assembly: AssemblyName = Field("freefem", description="tangent, internal forces and strains: freefem (the varf "

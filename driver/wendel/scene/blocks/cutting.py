@@ -106,10 +106,6 @@ class Cutting(BaseModel):
     snap_to_tool: bool = Field(False, description="FE: the remeshes move new boundary nodes that fall inside the "
                                "tool (on old edges of the machined surface that cut its rounded edge: 1.3-3.4 um "
                                "deep on the F-bar steel cut, measured) onto its surface, as remesh.snap_to_tool")
-    untangle_first_step: bool = Field(False, description="FE: the first Newton step of an increment is halved "
-                                      "while it tangles the mesh (numerics.first_step = untangle) instead of "
-                                      "failing the increment (most step cuts of the F-bar cut: the first increment "
-                                      "after each remesh, measured)")
     oxley: OxleyConstants = OxleyConstants()
 
     @model_validator(mode="after")
