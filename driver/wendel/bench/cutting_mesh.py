@@ -189,7 +189,9 @@ def cutting_steady_bench(quick: bool, workdir: Path) -> list[dict]:
     """The middle resolution (edge r/2) cut twice as far as the scene, 1.2 mm (8 h), on a block 2.6 mm long
     (the primary zone stays clear of its far end): whether and where the forces and the chip settle within 2 %
     (:func:`wendel.cutting.fe_steady.steady` on the remesh-cycle means, a window of one h), with the last
-    window's spreads and drifts. ``--quick``: 400 um."""
+    window's spreads and drifts, and where the running means over one h settle (``filtered``). ``--quick``:
+    400 um. ``WENDEL_BENCH_SNAP=1`` (also for ``cutting-steady-fbar`` and ``cutting-long``): with
+    ``cutting.snap_to_tool`` (folder ``...-snap``)."""
     return _steady(quick, workdir, "cell")
 
 
