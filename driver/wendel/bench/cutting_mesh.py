@@ -214,16 +214,6 @@ def cutting_steady_fbar_bench(quick: bool, workdir: Path) -> list[dict]:
                    folder=f"r2-fbar-{mm * 1e3:.0f}um" + (f"-remesh{every}" if every else ""))
 
 
-def _snap() -> bool:
-    """``WENDEL_BENCH_SNAP=1``: the cut with ``cutting.snap_to_tool`` (folder ``...-snap``); 0 or unset: as the
-    scene says."""
-    import os
-    v = os.environ.get("WENDEL_BENCH_SNAP", "0")
-    if v not in ("0", "1"):
-        raise ValueError(f"WENDEL_BENCH_SNAP = {v!r}: 1 (snap the remeshes' boundary nodes out of the tool) or 0")
-    return v == "1"
-
-
 def _cut_mm() -> float:
     """``WENDEL_BENCH_CUT_MM`` (default 2.4) [mm], refused by name outside (1.2, 20]."""
     import os
@@ -253,7 +243,11 @@ def _steady(quick: bool, workdir: Path, volumetric: str, remesh_every: int | Non
 
     from ..cutting.fe_steady import steady, window
     scene = _scene(2, 1, quick=False, volumetric=volumetric)
-    if _snap():
+    import os
+    snap = os.environ.get("WENDEL_BENCH_SNAP", "0")
+    if snap not in ("0", "1"):
+        raise ValueError(f"WENDEL_BENCH_SNAP = {snap!r}: 1 (cutting.snap_to_tool) or 0 (as the scene says)")
+    if snap == "1":
         scene.cutting.snap_to_tool = True
         folder = (folder or ("r2-long" if not remesh_every else f"r2-long-remesh{remesh_every}")) + "-snap"
     long = length > 1.2e-3
