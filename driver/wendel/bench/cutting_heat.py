@@ -118,7 +118,8 @@ def cutting_ti_bench(quick: bool, workdir: Path) -> list[dict]:
     r/2 (5 um), cut 400 um (the scene's whole cut; ``--quick`` 100 um): whether it runs, the remesh-cycle means of
     the forces and the chip thickness over the last 160 um, beside Oxley (about 10 minutes).
     ``WENDEL_BENCH_CUT_MM``: a longer cut [mm] (0.4 to 20) on a block 0.6 mm longer than the cut (folder
-    ``ti-r2-<um>um``), with the steady-state detector's spreads and drifts over the last h (``cutting-steady``'s)."""
+    ``ti-r2-<um>um``), with the steady-state detector's spreads and drifts over the last h (``cutting-steady``'s).
+    ``WENDEL_BENCH_SNAP=1``: with ``cutting.snap_to_tool`` (folder ``...-snap``)."""
     import os
 
     from ..cutting.scene import predict
@@ -132,12 +133,16 @@ def cutting_ti_bench(quick: bool, workdir: Path) -> list[dict]:
         scene.cutting.cut_length = float(mm) * 1e-3
         scene.loading.steps = round(scene.cutting.cut_length / 5e-6)
         scene.geometry.model_extra["length"] = scene.cutting.cut_length + 0.6e-3
+    snap = os.environ.get("WENDEL_BENCH_SNAP", "0")
+    if snap not in ("0", "1"):
+        raise ValueError(f"WENDEL_BENCH_SNAP = {snap!r}: 1 (cutting.snap_to_tool) or 0 (as the scene says)")
+    scene.cutting.snap_to_tool = scene.cutting.snap_to_tool or snap == "1"
     if quick:
         scene.cutting.cut_length *= 20 / scene.loading.steps
         scene.loading.steps = 20
     scene.cutting.edge_size = scene.cutting.edge_radius / 2
     workdir.mkdir(parents=True, exist_ok=True)
-    name = "ti-r2" if mm is None or quick else f"ti-r2-{float(mm) * 1e3:.0f}um"
+    name = ("ti-r2" if mm is None or quick else f"ti-r2-{float(mm) * 1e3:.0f}um") + ("-snap" if snap == "1" else "")
     row = _case("adiabatic", quick, workdir, scene=scene, scene_path=path, name=name)
     if mm is not None and not quick:
         import csv
