@@ -43,3 +43,9 @@ def test_a_settled_cut_is_found_by_all_after_its_rise():
     for m in ("cycles", "filtered"):
         assert st[m] is not None and st[m]["start_m"] >= 300e-6 - 2 * H
         assert abs(st[m]["values"]["Fc_N"] - 500.0) < 1.0
+
+
+def test_a_cut_shorter_than_the_windows_reports_none():
+    st = steady(_history(100, lambda x, k: 500.0), H)          # 100 um: less than one h of travel
+    assert st["filtered"] is None and st["cycles"] is None
+    assert st["last_window_spreads"]["filtered"] == {"Fc_N": None, "Ft_N": None, "chip_thickness_m": None}

@@ -123,8 +123,9 @@ def steady(rows: list[dict], length: float, tol: float = 0.02) -> dict:
     inc = [r for k, r in enumerate(rows) if not (k and abs(r["tool_travel_m"] - rows[k - 1]["tool_travel_m"]) <= 1e-12)]
     cyc = cycle_means(rows)
     run = running_means(rows, length)
-    last, trend = {}, {}
     spans = {"raw": length, "cycles": length, "filtered": 2 * length}
+    last = {name: dict.fromkeys(SERIES) for name in spans}        # None: too short a cut for the measure
+    trend = {name: dict.fromkeys(SERIES) for name in spans}
     for name, rr in (("raw", inc), ("cycles", cyc), ("filtered", run)):
         if rr:
             span = spans[name]
