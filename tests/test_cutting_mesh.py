@@ -89,6 +89,10 @@ def test_bad_zones_are_refused_with_the_key(tmp_path):
      "WENDEL_BENCH_CUT_MM = 25.0: a length of cut in mm above 1.2 (cutting-steady's) and up to 20"),
     ("cutting-steady-fbar", "WENDEL_BENCH_REMESH_EVERY", "six",
      "WENDEL_BENCH_REMESH_EVERY = 'six': a whole number of increments from 1 to 100"),
+    ("cutting-steady", "WENDEL_BENCH_SNAP", "yes",
+     "WENDEL_BENCH_SNAP = 'yes': 1 (cutting.snap_to_tool) or 0 (as the scene says)"),
+    ("cutting-ti", "WENDEL_BENCH_SNAP", "2",
+     "WENDEL_BENCH_SNAP = '2': 1 (cutting.snap_to_tool) or 0 (as the scene says)"),
 ])
 def test_the_long_cut_benches_refuse_a_bad_setting_by_name_before_cutting(tmp_path, monkeypatch, name, var, value,
                                                                            words):

@@ -35,6 +35,15 @@ def run_fresh(scene, path: Path, out: Path, smoke: bool = False) -> dict:
     return json.loads((out / "summary.json").read_text())
 
 
+def env_flag(name: str, what: str) -> bool:
+    """An on/off setting of a bench from the environment variable ``name``: 1 (``what``), 0 or unset (as the scene
+    says); anything else refused by name."""
+    v = os.environ.get(name, "0")
+    if v not in ("0", "1"):
+        raise ValueError(f"{name} = {v!r}: 1 ({what}) or 0 (as the scene says)")
+    return v == "1"
+
+
 def register(name: str):
     """Register a benchmark ``func(quick, workdir) -> rows`` under ``name``."""
 

@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import WORKFLOWS, register
+from . import WORKFLOWS, env_flag, register
 from .cutting_mesh import WINDOW, _finished, _scene, measure
 
 CONDUCTION = "staggered"
@@ -133,16 +133,14 @@ def cutting_ti_bench(quick: bool, workdir: Path) -> list[dict]:
         scene.cutting.cut_length = float(mm) * 1e-3
         scene.loading.steps = round(scene.cutting.cut_length / 5e-6)
         scene.geometry.model_extra["length"] = scene.cutting.cut_length + 0.6e-3
-    snap = os.environ.get("WENDEL_BENCH_SNAP", "0")
-    if snap not in ("0", "1"):
-        raise ValueError(f"WENDEL_BENCH_SNAP = {snap!r}: 1 (cutting.snap_to_tool) or 0 (as the scene says)")
-    scene.cutting.snap_to_tool = scene.cutting.snap_to_tool or snap == "1"
+    snap = env_flag("WENDEL_BENCH_SNAP", "cutting.snap_to_tool")
+    scene.cutting.snap_to_tool = scene.cutting.snap_to_tool or snap
     if quick:
         scene.cutting.cut_length *= 20 / scene.loading.steps
         scene.loading.steps = 20
     scene.cutting.edge_size = scene.cutting.edge_radius / 2
     workdir.mkdir(parents=True, exist_ok=True)
-    name = ("ti-r2" if mm is None or quick else f"ti-r2-{float(mm) * 1e3:.0f}um") + ("-snap" if snap == "1" else "")
+    name = ("ti-r2" if mm is None or quick else f"ti-r2-{float(mm) * 1e3:.0f}um") + ("-snap" if snap else "")
     row = _case("adiabatic", quick, workdir, scene=scene, scene_path=path, name=name)
     if mm is not None and not quick:
         import csv

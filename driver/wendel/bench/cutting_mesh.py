@@ -32,7 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import WORKFLOWS, register
+from . import WORKFLOWS, env_flag, register
 
 WINDOW = 160e-6  # m: the compared window, the last 160 um of travel (4 remesh cycles of 40 um without step cuts)
 STEPS = 80       # increments of 5 um: the first 400 um (2.7 h) of the scene's 600 um cut
@@ -243,11 +243,7 @@ def _steady(quick: bool, workdir: Path, volumetric: str, remesh_every: int | Non
 
     from ..cutting.fe_steady import steady, window
     scene = _scene(2, 1, quick=False, volumetric=volumetric)
-    import os
-    snap = os.environ.get("WENDEL_BENCH_SNAP", "0")
-    if snap not in ("0", "1"):
-        raise ValueError(f"WENDEL_BENCH_SNAP = {snap!r}: 1 (cutting.snap_to_tool) or 0 (as the scene says)")
-    if snap == "1":
+    if env_flag("WENDEL_BENCH_SNAP", "cutting.snap_to_tool"):
         scene.cutting.snap_to_tool = True
         folder = (folder or ("r2-long" if not remesh_every else f"r2-long-remesh{remesh_every}")) + "-snap"
     long = length > 1.2e-3

@@ -3,31 +3,17 @@ strain, with the tool (its rounded edge drawn as arcs) at its place on the path.
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import numpy as np
 
 
 def rounded_outline(vertices, radii, per_arc: int = 16) -> np.ndarray:
-    """The outline of a polygon whose corners are rounded by ``radii`` (the tool of ``edp/lib/tool.idp``)."""
-    v = np.asarray(vertices, dtype=float)
-    n, out = len(v), []
-    for i in range(n):
-        r = radii[i]
-        if r <= 0:
-            out.append(v[i])
-            continue
-        a, b = v[i - 1] - v[i], v[(i + 1) % n] - v[i]
-        a, b = a / np.linalg.norm(a), b / np.linalg.norm(b)
-        half = math.acos(np.clip(a @ b, -1, 1)) / 2
-        centre = v[i] + (a + b) / np.linalg.norm(a + b) * r / math.sin(half)
-        p0, p1 = v[i] + a * r / math.tan(half), v[i] + b * r / math.tan(half)
-        t0, t1 = math.atan2(*(p0 - centre)[::-1]), math.atan2(*(p1 - centre)[::-1])
-        sweep = (t1 - t0 + math.pi) % (2 * math.pi) - math.pi      # the short way round, through the corner
-        for t in t0 + np.linspace(0.0, sweep, per_arc):
-            out.append(centre + r * np.array([math.cos(t), math.sin(t)]))
-    return np.array(out)
+    """The outline of a polygon whose corners are rounded by ``radii`` (the tool of ``edp/lib/tool.idp``),
+    ``per_arc`` points on each arc (:func:`wendel.remesh.snap.outline`)."""
+    from ..remesh.snap import outline
+
+    return outline(vertices, radii, per_arc)
 
 
 def frame(path: Path, points, cells, p_cells, tool: dict, shift, title: str, h: float) -> Path:

@@ -22,6 +22,8 @@ corner radius per vertex (an arc tangent to both sides), placed by a shift.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 ARC_STEP = np.radians(0.25)      # the outline's arcs, for the inside test only (closest points are exact)
@@ -29,19 +31,19 @@ ARC_STEP = np.radians(0.25)      # the outline's arcs, for the inside test only 
 
 def _corners(vertices: np.ndarray, radii) -> list:
     """Per vertex: ``None`` for a sharp one, else its arc ``(centre, r, p_in, p_out)``, tangent to its two
-    sides, from where the boundary arrives to where it leaves (counter-clockwise)."""
+    sides, from where the boundary arrives to where it leaves (the tool of ``edp/lib/tool.idp``)."""
     v = np.asarray(vertices, dtype=float)
-    out = []
-    for i in range(len(v)):
-        a, b, c = v[i - 1], v[i], v[(i + 1) % len(v)]
-        r = float(radii[i])
+    n, out = len(v), []
+    for i in range(n):
+        r = radii[i]
         if r <= 0:
             out.append(None)
             continue
-        u, w = (a - b) / np.linalg.norm(a - b), (c - b) / np.linalg.norm(c - b)
-        half = 0.5 * np.arccos(np.clip(u @ w, -1.0, 1.0))
-        centre = b + (u + w) / np.linalg.norm(u + w) * r / np.sin(half)
-        out.append((centre, r, b + u * r / np.tan(half), b + w * r / np.tan(half)))
+        a, b = v[i - 1] - v[i], v[(i + 1) % n] - v[i]
+        a, b = a / np.linalg.norm(a), b / np.linalg.norm(b)
+        half = math.acos(np.clip(a @ b, -1, 1)) / 2
+        centre = v[i] + (a + b) / np.linalg.norm(a + b) * r / math.sin(half)
+        out.append((centre, r, v[i] + a * r / math.tan(half), v[i] + b * r / math.tan(half)))
     return out
 
 
@@ -54,18 +56,21 @@ def _pieces(vertices: np.ndarray, radii) -> tuple[list, list]:
     return segments, [c for c in corners if c is not None]
 
 
-def outline(vertices: np.ndarray, radii) -> np.ndarray:
-    """The rounded polygon as a closed polyline (arcs at ``ARC_STEP``), counter-clockwise."""
+def outline(vertices, radii, per_arc: int | None = None) -> np.ndarray:
+    """The rounded polygon as a closed polyline: ``per_arc`` points on each arc (default: one every
+    ``ARC_STEP``), each arc the short way round through its corner."""
+    v = np.asarray(vertices, dtype=float)
     out = []
-    for i, c in enumerate(_corners(vertices, radii)):
+    for i, c in enumerate(_corners(v, radii)):
         if c is None:
-            out.append(np.asarray(vertices[i], dtype=float))
+            out.append(v[i])
             continue
-        centre, r, p_in, p_out = c
-        t0, t1 = np.arctan2(*(p_in - centre)[::-1]), np.arctan2(*(p_out - centre)[::-1])
-        sweep = (t1 - t0) % (2 * np.pi)          # counter-clockwise around a convex corner
-        t = t0 + sweep * np.linspace(0.0, 1.0, max(2, int(np.ceil(sweep / ARC_STEP))) + 1)
-        out.extend(centre + r * np.column_stack([np.cos(t), np.sin(t)]))
+        centre, r, p0, p1 = c
+        t0, t1 = math.atan2(*(p0 - centre)[::-1]), math.atan2(*(p1 - centre)[::-1])
+        sweep = (t1 - t0 + math.pi) % (2 * math.pi) - math.pi
+        k = per_arc or max(2, math.ceil(abs(sweep) / ARC_STEP)) + 1
+        for t in t0 + np.linspace(0.0, sweep, k):
+            out.append(centre + r * np.array([math.cos(t), math.sin(t)]))
     return np.array(out)
 
 
@@ -125,16 +130,16 @@ def snap(points: np.ndarray, cells: np.ndarray, boundary: np.ndarray, vertices: 
     target, dist = closest(pts[moved_nodes], vertices, radii)
     move = np.zeros_like(pts)
     move[moved_nodes] = target - pts[moved_nodes]
-    free = np.zeros(len(pts), dtype=bool)                 # interior nodes near the moved ones
     near = np.zeros(len(pts), dtype=bool)
     near[moved_nodes] = True
     for _ in range(rings):
-        near |= np.isin(np.arange(len(pts)), cells[near[cells].any(axis=1)].ravel())
-    free[near] = True
+        near[cells[near[cells].any(axis=1)].ravel()] = True
+    free = near.copy()                                    # interior nodes near the moved ones
     free[boundary] = False
-    if free.any():          # Jacobi on the graph Laplacian of the cells' edges
+    if free.any():          # Jacobi on the graph Laplacian of the cells' edges out of the free nodes
         e = np.vstack([cells[:, [0, 1]], cells[:, [1, 2]], cells[:, [2, 0]]])
         e = np.vstack([e, e[:, ::-1]])
+        e = e[free[e[:, 0]]]
         deg = np.bincount(e[:, 0], minlength=len(pts)).astype(float)
         for _ in range(sweeps):
             acc = np.zeros_like(pts)
@@ -176,13 +181,10 @@ def tool_at(scene, inc_dir) -> dict | None:
     c = scene.contact
     if c is None or c.obstacle != "tool" or c.tool is None or c.tool.stl is not None or not c.tool.vertices:
         return None
-    import json
-
-    rec = json.loads((inc_dir / "record.json").read_text())
-    if abs(float(rec.get("tool_angle") or 0.0)) > 0:
+    shift, angle = placement(inc_dir)
+    if abs(angle) > 0:
         return None
-    shift = np.array([float(rec.get("tool_x") or 0.0), float(rec.get("tool_y") or 0.0)])
-    v = np.asarray(c.tool.vertices, dtype=float)[:, :2] + shift
+    v = np.asarray(c.tool.vertices, dtype=float)[:, :2] + shift[:2]
     radii = list(c.tool.radii) if c.tool.radii else [0.0] * len(v)
     return {"vertices": v, "radii": radii}
 
@@ -202,11 +204,15 @@ def onto_tool(mesh: "Path", points: np.ndarray, cells: np.ndarray, tool: dict) -
 def zones_at(r, inc_dir) -> list[dict]:
     """The size zones of ``remesh`` (``r``) for the remesh after increment ``inc_dir``: as written, or moved by
     the tool's placement (``tool_x``, ``tool_y``(, ``tool_z``) of its record.json) when they follow the tool."""
-    shift = np.zeros(3)
-    if r.zones and r.zones_follow == "tool":
-        import json
-
-        rec = json.loads((inc_dir / "record.json").read_text())
-        shift = np.array([float(rec.get(f"tool_{a}", 0.0)) for a in "xyz"])
+    shift = placement(inc_dir)[0] if r.zones and r.zones_follow == "tool" else np.zeros(3)
     return [{"box": [[c + d for c, d in zip(corner, shift)] for corner in z.box], "h": z.h, "thickness": z.thickness}
             for z in r.zones]
+
+
+def placement(inc_dir) -> tuple[np.ndarray, float]:
+    """The tool's placement at increment ``inc_dir``: its shift (``tool_x``, ``tool_y``, ``tool_z`` of its
+    record.json, 0 where missing or empty) and turn (``tool_angle``)."""
+    import json
+
+    rec = json.loads((inc_dir / "record.json").read_text())
+    return np.array([float(rec.get(f"tool_{a}") or 0.0) for a in "xyz"]), float(rec.get("tool_angle") or 0.0)
