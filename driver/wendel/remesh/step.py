@@ -32,7 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from .again import AGAIN, made_or_failed
-from .snap import tool_at, zones_at       # where the tool stands at a remesh (numpy only)
+from .snap import onto_tool, tool_at, zones_at       # the tool where it stands at a remesh (numpy only)
 from . import quality       # mesher (meshio, gmsh) and transfer (scipy) when a run remeshes: a run without
                             # remeshing judges its mesh only and does not pay their imports
 from ..results import vtu
@@ -126,7 +126,6 @@ def remesh_state(inc_dir: Path, mesh_old: Path, ubase_old: np.ndarray | None, di
     Y = Y[:, :dimension]
     snapped = {}
     if tool is not None and dimension == 2 and deformed:
-        from .snap import onto_tool
         Y, snapped = onto_tool(mesh_new, Y, new_cells, tool)
     state_new.mkdir(parents=True, exist_ok=True)
     report = {"old_nodes": n_old, "old_elements": len(cells), "new_nodes": len(Y), "new_elements": len(new_cells),
