@@ -119,7 +119,8 @@ def cutting_ti_bench(quick: bool, workdir: Path) -> list[dict]:
     the forces and the chip thickness over the last 160 um, beside Oxley (about 10 minutes).
     ``WENDEL_BENCH_CUT_MM``: a longer cut [mm] (0.4 to 20) on a block 0.6 mm longer than the cut (folder
     ``ti-r2-<um>um``), with the steady-state detector's spreads and drifts over the last h (``cutting-steady``'s).
-    ``WENDEL_BENCH_SNAP=1``: with ``cutting.snap_to_tool`` (folder ``...-snap``)."""
+    ``WENDEL_BENCH_SNAP=1``: with ``cutting.snap_to_tool`` (folder ``...-snap``); ``WENDEL_BENCH_FBAR=1``: with
+    ``cutting.volumetric = "fbar"`` (folder ``...-fbar``)."""
     import os
 
     from ..cutting.scene import predict
@@ -135,12 +136,15 @@ def cutting_ti_bench(quick: bool, workdir: Path) -> list[dict]:
         scene.geometry.model_extra["length"] = scene.cutting.cut_length + 0.6e-3
     snap = env_flag("WENDEL_BENCH_SNAP", "cutting.snap_to_tool")
     scene.cutting.snap_to_tool = scene.cutting.snap_to_tool or snap
+    fbar = env_flag("WENDEL_BENCH_FBAR", 'cutting.volumetric = "fbar"')
+    if fbar:
+        scene.cutting.volumetric = "fbar"
     if quick:
         scene.cutting.cut_length *= 20 / scene.loading.steps
         scene.loading.steps = 20
     scene.cutting.edge_size = scene.cutting.edge_radius / 2
     workdir.mkdir(parents=True, exist_ok=True)
-    name = ("ti-r2" if mm is None or quick else f"ti-r2-{float(mm) * 1e3:.0f}um") + ("-snap" if snap else "")
+    name = ("ti-r2" if mm is None or quick else f"ti-r2-{float(mm) * 1e3:.0f}um") + ("-snap" if snap else "") + ("-fbar" if fbar else "")
     row = _case("adiabatic", quick, workdir, scene=scene, scene_path=path, name=name)
     if mm is not None and not quick:
         import csv
