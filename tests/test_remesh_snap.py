@@ -9,6 +9,7 @@ from __future__ import annotations
 import json
 
 import numpy as np
+import pytest
 
 from wendel.remesh import mesher, quality, snap
 from wendel.results import separation, vtu
@@ -93,3 +94,34 @@ def test_a_cut_snaps_at_its_remeshes(tmp_path):
         b = Y[np.unique(mesher.boundary_facets(cells)), :2]
         ins = snap.inside(b, v, tool["radii"])
         assert not ins.any() or snap.closest(b[ins], v, tool["radii"])[1].max() < 1e-9 * tool["radii"][1]
+
+
+_SNAP = "\n[remesh]\nsnap_to_tool = true\n"
+_TOOL = "radii = [0.5, 0.0, 0.0] }"
+_PATH = "y = [0.0, -0.01, -0.01] }"
+SNAP_REFUSED = [
+    ("hertz.toml", ("[loading]", "[loading]"),
+     "remesh.snap_to_tool needs a 2D polygon tool (contact.obstacle = \"tool\" with contact.tool.vertices)"),
+    ("scratch.toml", ("1.4226497308103742], [-2.598", "1.4226497308103742], [0.0, 1.0], [-2.598"),
+     "remesh.snap_to_tool handles convex tools; contact.tool.vertices[2] is a reflex corner"),
+    ("scratch.toml", (_PATH, "y = [0.0, -0.01, -0.01], angle = [0.0, 0.0, 5.0] }"),
+     "remesh.snap_to_tool is for a tool that only translates; contact.path.angle turns it"),
+]
+
+
+@pytest.mark.parametrize("scene,change,words", SNAP_REFUSED, ids=["no polygon tool", "reflex corner", "turned tool"])
+def test_a_snap_it_cannot_make_is_refused_by_key(scene_file, scene, change, words):
+    """``remesh.snap_to_tool`` where :mod:`wendel.remesh.snap` would do nothing or the wrong thing (no polygon
+    tool, a concave one, a turned one): the scene is refused naming the file and the key, not run unsnapped."""
+    from conftest import WORKFLOWS, edit
+
+    from wendel.scene import SceneError, load
+
+    text = edit((WORKFLOWS / scene).read_text(), *change)
+    if "reflex" in words:
+        text = edit(text, _TOOL, "radii = [0.5, 0.0, 0.0, 0.0] }")
+    path = scene_file(text + _SNAP)
+    with pytest.raises(SceneError) as exc:
+        load(path)
+    assert str(path) in str(exc.value) and words in str(exc.value)
+    load(scene_file((WORKFLOWS / scene).read_text() + ("" if scene == "hertz.toml" else _SNAP), "ok.toml"))

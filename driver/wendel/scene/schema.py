@@ -412,6 +412,8 @@ class SceneBase(Strict):
         if self.remesh is not None and self.remesh.zones_follow == "tool" and \
                 getattr(getattr(self, "contact", None), "path", None) is None:
             raise ValueError("remesh.zones_follow = \"tool\" needs a moving tool (contact.path)")
+        if self.remesh is not None and self.remesh.snap_to_tool:
+            check_snap(getattr(self, "contact", None))
         check_kernels(self)                # numerics.assembly = "compiled" against the other tables
         if self.problem == "mechanics":
             check_axisymmetric(self)       # elasticity.plane/order/reference against the other tables
@@ -426,6 +428,24 @@ class SceneBase(Strict):
 
 
 Scene = _scene_model()
+
+
+def check_snap(contact) -> None:
+    """``remesh.snap_to_tool`` is for what :mod:`wendel.remesh.snap` handles: a rigid 2D polygon tool
+    (``contact.tool.vertices``) that is convex (the snap's closest points assume convex corners) and only
+    translates (no ``contact.path.angle``); anything else refused by key rather than snapped by nothing."""
+    tool = getattr(contact, "tool", None) if getattr(contact, "obstacle", None) == "tool" else None
+    if tool is None or tool.vertices is None:
+        raise ValueError("remesh.snap_to_tool needs a 2D polygon tool (contact.obstacle = \"tool\" with "
+                         "contact.tool.vertices); this scene has none")
+    v = tool.vertices
+    for k in range(len(v)):
+        a, b, c = v[k - 1], v[k], v[(k + 1) % len(v)]
+        if (b[0] - a[0]) * (c[1] - b[1]) - (b[1] - a[1]) * (c[0] - b[0]) < 0:
+            raise ValueError(f"remesh.snap_to_tool handles convex tools; contact.tool.vertices[{k}] is a reflex corner")
+    path = getattr(contact, "path", None)
+    if path is not None and any(a != 0 for a in (path.angle or [])):
+        raise ValueError("remesh.snap_to_tool is for a tool that only translates; contact.path.angle turns it")
 
 
 def _describe(model: type[BaseModel], prefix: str) -> list[tuple[str, str, str, str]]:
