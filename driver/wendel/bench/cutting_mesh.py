@@ -191,7 +191,8 @@ def cutting_steady_bench(quick: bool, workdir: Path) -> list[dict]:
     (:func:`wendel.cutting.fe_steady.steady` on the remesh-cycle means, a window of one h), with the last
     window's spreads and drifts, and where the running means over one h settle (``filtered``). ``--quick``:
     400 um. ``WENDEL_BENCH_SNAP=1`` (also for ``cutting-steady-fbar`` and ``cutting-long``): with
-    ``cutting.snap_to_tool`` (folder ``...-snap``)."""
+    ``cutting.snap_to_tool`` (folder ``...-snap``); ``WENDEL_BENCH_CONDUCTION=1``: with heat conduction and
+    frictional heat (``thermal.coupling = "staggered"``, as ``cutting-heat``; folder ``...-conduction``)."""
     return _steady(quick, workdir, "cell")
 
 
@@ -243,9 +244,11 @@ def _steady(quick: bool, workdir: Path, volumetric: str, remesh_every: int | Non
 
     from ..cutting.fe_steady import steady, window
     scene = _scene(2, 1, quick=False, volumetric=volumetric)
+    folder = folder or ("r2-long" if not remesh_every else f"r2-long-remesh{remesh_every}")
     if env_flag("WENDEL_BENCH_SNAP", "cutting.snap_to_tool"):
-        scene.cutting.snap_to_tool = True
-        folder = (folder or ("r2-long" if not remesh_every else f"r2-long-remesh{remesh_every}")) + "-snap"
+        scene.cutting.snap_to_tool, folder = True, folder + "-snap"
+    if env_flag("WENDEL_BENCH_CONDUCTION", 'thermal.coupling = "staggered"'):
+        scene.thermal.coupling, folder = "staggered", folder + "-conduction"
     long = length > 1.2e-3
     length = 0.4e-3 if quick else length
     scene.geometry.model_extra["length"] = block
@@ -253,7 +256,7 @@ def _steady(quick: bool, workdir: Path, volumetric: str, remesh_every: int | Non
     scene.loading.steps = round(length / 5e-6)
     if remesh_every:
         scene.cutting.remesh_every = remesh_every
-    out = workdir / (folder or ("r2-long" if not remesh_every else f"r2-long-remesh{remesh_every}"))
+    out = workdir / folder
     shutil.rmtree(out, ignore_errors=True)
     from ..cutting.fe_run import run_cut
     from ..errors import StepCutError
