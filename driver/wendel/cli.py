@@ -88,6 +88,7 @@ def main(argv: list[str] | None = None) -> int:
                    "only when named: step42-dealii, step42-pair (deal.II and wendel interleaved, about 8 minutes),\n"
                    "  step42-accuracy (the time to a force within 2 %% of the converged one, about 7 minutes),\n"
                    "  overhead, gmsh3d, meshcache (the ball with a cold and a warm mesh cache, about 3 minutes),\n"
+                   "  sweep-warm (20 smoke runs of a local sweep, forked warm and as fresh interpreters, about 2 minutes),\n"
                    "  ranks (the ball on 1 and 2 PETSc ranks, interleaved, about 4 minutes),\n"
                    "  cutting, cutting-isothermal (the FE orthogonal cut, about 15 minutes each),\n"
                    "  cutting-mesh (the FE cut at 3 edge resolutions and 2 steps, about an hour), cutting-fbar,\n"

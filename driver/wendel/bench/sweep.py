@@ -87,3 +87,45 @@ def sweep_bench(quick: bool, workdir: Path) -> list[dict]:
             os.environ["SLURM_CONF"] = old
         subprocess.run(["bash", str(script), "stop", str(cluster)], capture_output=True, timeout=120)
     return rows
+
+
+@register("sweep-warm")
+def sweep_warm_bench(quick: bool, workdir: Path) -> list[dict]:
+    """The same 20 smoke runs (6 with --quick) of a local sweep on 2 workers, forked from one warm server
+    (:mod:`wendel.sweep.warm`, the default) and as fresh interpreters (``WENDEL_SWEEP_WARM=0``), interleaved
+    twice (cold, warm, cold, warm): per run the sweep's wall time and CPU seconds (user + system of every process
+    it waited for: ``RUSAGE_CHILDREN``), the mean run wall time and the runs' summary wall time; the last row the
+    warm / cold ratios of the medians."""
+    import resource
+    import statistics
+
+    from ..sweep import run_sweep
+
+    shutil.rmtree(workdir, ignore_errors=True)
+    workdir.mkdir(parents=True)
+    n = 6 if quick else 20
+    sweep = _sweep_file(workdir, n, "runs")
+    old = os.environ.get("WENDEL_SWEEP_WARM")
+    rows = []
+    try:
+        for k, warm in enumerate(("0", "1", "0", "1")):
+            os.environ["WENDEL_SWEEP_WARM"] = warm
+            ru0, t0 = resource.getrusage(resource.RUSAGE_CHILDREN), time.perf_counter()
+            rep = run_sweep(sweep, out=workdir / f"{k}-{'warm' if warm == '1' else 'cold'}", workers=2, quiet=True,
+                            log=lambda *_: None)
+            wall, ru = time.perf_counter() - t0, resource.getrusage(resource.RUSAGE_CHILDREN)
+            row = _figures(rep, "local, warm" if warm == "1" else "local, cold", n, wall)
+            row.update({"wall_per_run_s": wall / n, "cpu_per_run_s": (ru.ru_utime + ru.ru_stime - ru0.ru_utime - ru0.ru_stime) / n,
+                        "load_average": os.getloadavg()[0]})
+            rows.append(row)
+    finally:
+        if old is None:
+            os.environ.pop("WENDEL_SWEEP_WARM", None)
+        else:
+            os.environ["WENDEL_SWEEP_WARM"] = old
+
+    def med(label, key):
+        return statistics.median(r[key] for r in rows if r["executor"] == label)
+    rows.append({"executor": "warm / cold", **{f"{k}_ratio": med("local, warm", k) / med("local, cold", k)
+                                              for k in ("wall_per_run_s", "cpu_per_run_s", "mean_run_wall", "sum_summary_wall")}})
+    return rows

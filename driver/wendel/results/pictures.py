@@ -171,8 +171,10 @@ class Painter:
         import sys
 
         self.renderer = renderer
-        # its own session: Ctrl-C stops the driver, whose closing of stdin then ends this process
-        self.proc = subprocess.Popen([sys.executable, "-m", "wendel.results.pictures", renderer],
+        # a run forked by a sweep's warm server forks it too (matplotlib imported); else a new interpreter,
+        # in its own session: Ctrl-C stops the driver, whose closing of stdin then ends this process
+        warm = sys.modules.get("wendel.sweep.warm")
+        self.proc = (warm and warm.fork_painter(renderer)) or subprocess.Popen([sys.executable, "-m", "wendel.results.pictures", renderer],
                                      stdin=subprocess.PIPE,
                                      stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True,
                                      start_new_session=True)
@@ -233,12 +235,12 @@ def painter(renderer: str) -> Painter:
     return Painter(renderer)
 
 
-def _serve() -> None:
-    """The picture process: warm up (import, one off-screen render), then one picture per request line."""
+def serve_lines(renderer: str, stdin, stdout) -> None:
+    """Warm up (import, one off-screen render), then one picture per request line of ``stdin``, answered on
+    ``stdout``, until ``stdin`` closes."""
     import json
-    import sys
 
-    if sys.argv[1:] == ["matplotlib"]:
+    if renderer == "matplotlib":
         import matplotlib
 
         matplotlib.use("Agg")
@@ -249,15 +251,22 @@ def _serve() -> None:
     else:
         _warm_up()
         draw = picture
-    for line in sys.stdin:
+    for line in stdin:
         try:
             req = json.loads(line)
             draw(Path(req["vtu"]), Path(req["png"]), req["title"], req["warp"], deformed=req.get("deformed", False))
             answer = "ok"
         except Exception as exc:        # noqa: BLE001 - reported to the driver, which raises it
             answer = f"{type(exc).__name__}: {exc}".replace("\n", " ")
-        sys.stdout.write(answer + "\n")
-        sys.stdout.flush()
+        stdout.write(answer + "\n")
+        stdout.flush()
+
+
+def _serve() -> None:
+    """The picture process (:func:`serve_lines` on its standard streams)."""
+    import sys
+
+    serve_lines(sys.argv[1] if sys.argv[1:] == ["matplotlib"] else "pyvista", sys.stdin, sys.stdout)
     # stdin closed: the driver waits for this exit; skip the interpreter's tear-down of matplotlib or VTK
     # (0.1 s here, in the run's wall time) - every picture is written and answered
     os._exit(0)

@@ -88,6 +88,16 @@ def run_sweep(sweep_path: Path, out: Path | None = None, executor: str = "local"
     Every planned scene is validated first (:class:`wendel.scene.SceneError` before anything runs).
     """
     t0 = time.perf_counter()
+    from .warm import Warm, enabled
+    server = Warm() if executor == "local" and enabled() else None     # its imports overlap the planning
+    try:
+        return _run_sweep(t0, server, sweep_path, out, executor, workers, slurm, detach, quiet, log)
+    finally:
+        if server is not None:
+            server.close()
+
+
+def _run_sweep(t0, server, sweep_path, out, executor, workers, slurm, detach, quiet, log) -> dict:
     from .plan import load_sweep
 
     sweep = load_sweep(sweep_path)
@@ -109,7 +119,7 @@ def run_sweep(sweep_path: Path, out: Path | None = None, executor: str = "local"
             write_json(root / "slurm" / "jobs.json", {k: v for k, v in jobs.items() if k not in todo})
         n = workers or sweep.spec.workers or default_workers(max(r.ranks for r in sweep.runs))
         try:
-            outcomes = run_local(root, todo, n, skipped=counts[DONE], quiet=quiet)
+            outcomes = run_local(root, todo, n, skipped=counts[DONE], quiet=quiet, warm=server)
         finally:
             lock.close()
         report["outcomes"] = outcomes

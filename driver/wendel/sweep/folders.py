@@ -104,10 +104,13 @@ class Stopped(Exception):
 
 
 def execute(root: Path, key: str, on_start=None, stop: threading.Event | None = None,
-            killed_is_failure: bool = True) -> dict:
+            killed_is_failure: bool = True, warm=None) -> dict:
     """Bring the run ``key`` of the sweep in ``root`` to an end: skip it when done, resume it when
     interrupted, start it afresh otherwise (failed attempts moved aside). Runs ``wendel run`` as a
     subprocess in its own process group; ``on_start(proc)`` is called with it (to stop it on Ctrl-C).
+
+    ``warm``: a :class:`wendel.sweep.warm.Warm` server that forks the run instead (the same arguments, log and
+    process group), or None.
 
     A run killed by a signal (or stopped by one: exit 130) is failed, unless ``killed_is_failure`` is false (under SLURM: the scheduler
     killed it, to requeue it or for good, and :func:`wendel.sweep.slurm.reconcile` reads which); it then
@@ -135,8 +138,10 @@ def execute(root: Path, key: str, on_start=None, stop: threading.Event | None = 
     with open(log, "a") as flog:
         flog.write(f"$ {' '.join(cmd)}\n")
         flog.flush()
-        proc = subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=flog, stderr=subprocess.STDOUT,
-                                start_new_session=True)
+        proc = warm.spawn(["run", *args], log) if warm is not None else None
+        if proc is None:
+            proc = subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=flog, stderr=subprocess.STDOUT,
+                                    start_new_session=True)
         if on_start is not None:
             on_start(proc)
         try:
@@ -150,6 +155,7 @@ def execute(root: Path, key: str, on_start=None, stop: threading.Event | None = 
         old = read_json(folder / "sweep.json") or {}
         write_json(folder / "sweep.json", {"status": DONE, "wall": old.get("wall", 0.0) + wall, "exit": rc,
                                            "attempts": old.get("attempts", 0) + 1, "action": action,
+                                           "warm": not isinstance(proc, subprocess.Popen),
                                            "ended": time.strftime("%Y-%m-%dT%H:%M:%S%z")})
         return {"key": key, "status": DONE, "wall": wall, "message": "", "action": action}
     if stop is not None and stop.is_set():

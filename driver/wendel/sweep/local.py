@@ -23,11 +23,18 @@ def default_workers(ranks: int) -> int:
     return max(1, (os.cpu_count() or 1) // max(1, ranks))
 
 
-def run_local(root: Path, keys: list[str], workers: int, skipped: int = 0, quiet: bool = False) -> list[dict]:
+def run_local(root: Path, keys: list[str], workers: int, skipped: int = 0, quiet: bool = False,
+              warm=None) -> list[dict]:
     """Run ``keys`` (none of them done) ``workers`` at a time; return one outcome dict per finished run.
 
-    Raises KeyboardInterrupt after stopping every run when interrupted.
+    Raises KeyboardInterrupt after stopping every run when interrupted. ``warm``: the runs are forked from
+    that server (:mod:`wendel.sweep.warm`; :func:`wendel.sweep.run_sweep` starts one unless
+    ``WENDEL_SWEEP_WARM=0``), else each is a subprocess.
     """
+    return _run(root, keys, workers, skipped, quiet, warm)
+
+
+def _run(root: Path, keys: list[str], workers: int, skipped: int, quiet: bool, warm) -> list[dict]:
     from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 
@@ -43,7 +50,7 @@ def run_local(root: Path, keys: list[str], workers: int, skipped: int = 0, quiet
                 procs[key] = proc
                 running.add(key)
         try:
-            return execute(root, key, on_start=started, stop=stop)
+            return execute(root, key, on_start=started, stop=stop, warm=warm)
         finally:
             with lock:
                 procs.pop(key, None)
