@@ -241,3 +241,21 @@ def test_one_local_sweep_at_a_time_per_folder(tmp_path):
         second = wendel("sweep", sweep, "--out", out, "--quiet")
     assert second.returncode == 2 and "another wendel sweep is running" in second.stderr
     assert not any((out / "runs").iterdir())
+
+
+def test_several_runs_in_one_slurm_task_are_forked_warm(tmp_path, slurm_cluster):
+    """``slurm.runs_per_task = 2``: three runs in two tasks of one array (the first two share a job id and are
+    forked from one warm process, the third runs alone as a subprocess), all done; 0 is refused by key."""
+    sweep = sweep_file(tmp_path, '[zip]\n"material.E" = [1.0, 2.0, 3.0]   # Pa\n'
+                       '[slurm]\ntime = 5\nmem = "1G"\nruns_per_task = 2\n')
+    out = tmp_path / "out"
+    keys = [r.key for r in load_sweep(sweep).runs]
+    rep = run_sweep(sweep, out=out, executor="slurm", quiet=True)
+    jobs = rep["jobs"]
+    assert jobs[keys[0]] == jobs[keys[1]] != jobs[keys[2]], jobs
+    assert [r["status"] for r in rep["rows"]] == ["done"] * 3, (rep["rows"], [p.read_text()[-2000:] for p in
+                                                                      (out / "slurm").rglob("*.out")])
+    warm = [json.loads((run_dir(out, k) / "sweep.json").read_text())["warm"] for k in keys]
+    assert warm == [True, True, False], [(out / "logs" / f"{k}.log").read_text()[-2000:] for k in keys]
+    bad = wendel("sweep", sweep, "--out", tmp_path / "bad", "--executor", "slurm", "--runs-per-task", "0")
+    assert bad.returncode == 2 and "runs_per_task" in bad.stderr, bad.stderr

@@ -5,8 +5,9 @@ Local: 40 smoke-size runs (8 with --quick) with 2 workers. Efficiency = sum of t
 included); a second figure uses the runs' summary.json wall time (FreeFEM, meshing, output: without the
 Python start-up of each ``wendel run``). SLURM (when root and the packages are installed): a single-node
 cluster is started by scripts/slurm-local.sh, 10 runs (4 with --quick) go through submitit job arrays
-with parallelism 2; overhead per run = (2 x sweep wall time - sum of the runs' wall times) / runs, the
-same formula applied to the local sweep for comparison.
+with parallelism 2, once a run a task and once in two tasks (``slurm.runs_per_task``, runs forked warm); overhead
+per run = (2 x sweep wall time - sum of the runs' wall times) / runs, the same formula applied to the local sweep
+for comparison.
 """
 
 from __future__ import annotations
@@ -22,12 +23,12 @@ from . import register
 ROOT = Path(__file__).resolve().parents[3]
 
 
-def _sweep_file(workdir: Path, n: int, name: str) -> Path:
+def _sweep_file(workdir: Path, n: int, name: str, per_task: int = 1) -> Path:
     values = ", ".join(f"{1.0 + k:.1f}" for k in range(n))
     p = workdir / f"{name}.toml"
     p.write_text(f'description = "bench: {n} smoke runs"\nscene = "{ROOT / "workflows" / "smoke.toml"}"\n'
                  f'smoke = true\noutputs = ["strain_energy"]\n[zip]\n"material.E" = [{values}]   # Pa\n'
-                 f'[slurm]\ntime = 10\nmem = "1G"\nparallelism = 2\n')
+                 f'[slurm]\ntime = 10\nmem = "1G"\nparallelism = 2\nruns_per_task = {per_task}\n')
     return p
 
 
@@ -76,6 +77,10 @@ def sweep_bench(quick: bool, workdir: Path) -> list[dict]:
         t0 = time.perf_counter()
         rep = run_sweep(sweep, out=workdir / "slurm", executor="slurm", quiet=True, log=lambda *_: None)
         rows.append({**_figures(rep, "slurm", m, time.perf_counter() - t0), "cluster_start_s": start_s})
+        sweep = _sweep_file(workdir, m, "slurm-per-task", per_task=m // 2)
+        t0 = time.perf_counter()
+        rep = run_sweep(sweep, out=workdir / "slurm-per-task", executor="slurm", quiet=True, log=lambda *_: None)
+        rows.append(_figures(rep, f"slurm, {m // 2} runs a task (warm)", m, time.perf_counter() - t0))
         local = _sweep_file(workdir, m, "local-same")
         t0 = time.perf_counter()
         rep = run_sweep(local, out=workdir / "local-same", workers=2, quiet=True, log=lambda *_: None)

@@ -127,7 +127,9 @@ def _run_sweep(t0, server, sweep_path, out, executor, workers, slurm, detach, qu
     elif todo and executor == "slurm":
         from . import slurm as slurm_exec
 
-        opts = sweep.spec.slurm.model_copy(update={k: v for k, v in (slurm or {}).items() if v is not None})
+        from .plan import Slurm
+        opts = Slurm.model_validate({**sweep.spec.slurm.model_dump(),       # the command line's values validated too
+                                     **{k: v for k, v in (slurm or {}).items() if v is not None}})
         report["jobs"] = slurm_exec.submit(root, plan, todo, opts, log=log)
         if not detach:
             slurm_exec.wait(root, plan, quiet=quiet)

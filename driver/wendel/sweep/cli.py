@@ -19,10 +19,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--executor", choices=("local", "slurm"), default="local")
     p.add_argument("--workers", type=int, help="local runs at a time (default cores / ranks per run)")
     p.add_argument("--partition", help="SLURM partition")
-    p.add_argument("--time", type=int, help="SLURM time limit of one run [min]")
-    p.add_argument("--mem", help="SLURM memory of one run (e.g. 2G)")
+    p.add_argument("--time", type=int, help="SLURM time limit of one task [min]")
+    p.add_argument("--mem", help="SLURM memory of one task (e.g. 2G)")
     p.add_argument("--cpus-per-run", type=int, help="SLURM CPUs of one run")
-    p.add_argument("--parallelism", type=int, help="SLURM runs at a time (array parallelism)")
+    p.add_argument("--parallelism", type=int, help="SLURM tasks at a time (array parallelism)")
+    p.add_argument("--runs-per-task", type=int, help="SLURM runs of one task (forked from one warm process)")
     p.add_argument("--detach", action="store_true", help="SLURM: submit and return")
     p.add_argument("--quiet", action="store_true", help="no progress display")
 
@@ -47,7 +48,7 @@ def command(args) -> int:
     if rest:
         raise ValueError(f"wendel sweep takes one sweep file (or status/collect TARGET), got {' '.join(args.target)}")
     slurm = {"partition": args.partition, "time": args.time, "mem": args.mem, "cpus_per_run": args.cpus_per_run,
-             "parallelism": args.parallelism}
+             "parallelism": args.parallelism, "runs_per_task": args.runs_per_task}
     try:
         rep = run_sweep(Path(first), out=args.out, executor=args.executor, workers=args.workers, slurm=slurm,
                         detach=args.detach, quiet=args.quiet)

@@ -20,8 +20,7 @@ applied to every run. Every planned scene is validated first; a bad one refuses 
 >>> points = grid_points({"a": [1, 2], "b": [3, 4]})
 >>> [tuple(p.values()) for p in points]
 [(1, 3), (1, 4), (2, 3), (2, 4)]
->>> [p["x"] for p in sample_points("lhs", 4, 1, {"x": [0.0, 1.0]})] == sorted(
-...     p["x"] for p in sample_points("lhs", 4, 1, {"x": [0.0, 1.0]}))
+>>> (xs := [p["x"] for p in sample_points("lhs", 4, 1, {"x": [0.0, 1.0]})]) == sorted(xs)
 False
 >>> sorted(int(4 * p["x"]) for p in sample_points("lhs", 4, 1, {"x": [0.0, 1.0]}))
 [0, 1, 2, 3]
@@ -83,14 +82,15 @@ class Sample(BaseModel):
 
 
 class Slurm(BaseModel):
-    """Resources of one run on SLURM (each run is one task of a job array)."""
+    """Resources of one task of a job array on SLURM (``runs_per_task`` runs, one after the other)."""
 
     model_config = ConfigDict(extra="forbid")
     partition: Optional[str] = Field(None, description="partition (default: the cluster's default)")
-    time: int = Field(60, ge=1, description="time limit of one run [min]; past it the run is requeued")
-    mem: str = Field("2G", description="memory of one run (sbatch --mem)")
+    time: int = Field(60, ge=1, description="time limit of one task [min]; past it the task is requeued")
+    mem: str = Field("2G", description="memory of one task (sbatch --mem)")
     cpus_per_run: Optional[int] = Field(None, ge=1, description="CPUs of one run (default: its MPI ranks)")
-    parallelism: int = Field(16, ge=1, description="runs at a time (array parallelism)")
+    parallelism: int = Field(16, ge=1, description="tasks at a time (array parallelism)")
+    runs_per_task: int = Field(1, ge=1, description="runs of one task, forked from one warm process (small runs)")
 
 
 class SweepFile(BaseModel):

@@ -1,7 +1,8 @@
 """Run a sweep on SLURM through submitit job arrays.
 
 Each run is one task of an array (``sbatch --array``, at most ``parallelism`` at a time), chunked below the
-cluster's MaxArraySize. The task calls :func:`wendel.sweep.folders.execute`, the same code as a local
+cluster's MaxArraySize; with ``slurm.runs_per_task`` = k, k runs are one task (the scheduler's start per task
+shared, the runs forked from one warm process). The task calls :func:`wendel.sweep.folders.execute`, the same code as a local
 run: it resumes an interrupted run from its checkpoint. The job is ``Checkpointable``: on timeout or
 preemption submitit requeues it and the run resumes. A run that fails records its message in its folder;
 a job the scheduler killed (scancel, out of memory, node failure) is recorded failed by :func:`reconcile`,
@@ -29,16 +30,30 @@ REQUEUE_WAIT = 30.0
 
 
 class RunJob(submitit.helpers.Checkpointable):
-    """One run of a sweep as a SLURM task; requeued on timeout or preemption (resumes from its checkpoint)."""
+    """Runs of a sweep as one SLURM task (``slurm.runs_per_task`` of them, one after the other; more than one
+    forked from a warm process, :mod:`wendel.sweep.warm`); requeued on timeout or preemption: the runs done are
+    skipped, the interrupted one resumes from its checkpoint."""
 
-    def __call__(self, root: str, key: str) -> dict:
-        result = execute(Path(root), key, killed_is_failure=False)
-        if result["status"] == INTERRUPTED:
-            # SLURM signals every process of the task (USR2 before a time limit or a preemption): the run's own
-            # process can die of it before this one's handler (submitit's requeue) has run; returning now would
-            # end the job as done, unrequeued (seen once in a CI run). Wait here for the signal and the requeue.
-            time.sleep(REQUEUE_WAIT)        # a signal's handler runs during it; the sleep then goes on (PEP 475)
-        return result
+    def __call__(self, root: str, keys: str | list[str]) -> list[dict]:
+        from .warm import Warm, enabled
+
+        keys = [keys] if isinstance(keys, str) else keys
+        server = Warm() if len(keys) > 1 and enabled() else None
+        results = []
+        try:
+            for key in keys:
+                results.append(execute(Path(root), key, killed_is_failure=False, warm=server))
+                if results[-1]["status"] == INTERRUPTED:
+                    # SLURM signals every process of the task (USR2 before a time limit or a preemption): the
+                    # run's own process can die of it before this one's handler (submitit's requeue) has run;
+                    # returning now would end the job as done, unrequeued (seen once in a CI run). Wait here
+                    # for the signal and the requeue.
+                    time.sleep(REQUEUE_WAIT)   # a signal's handler runs during it; the sleep then goes on (PEP 475)
+                    break
+        finally:
+            if server is not None:
+                server.close()
+        return results
 
 
 def max_array_size() -> int:
@@ -70,18 +85,20 @@ def submit(root: Path, plan: dict, keys: list[str], opts, log=print) -> dict:
     if opts.partition:
         params["partition"] = opts.partition
     executor.update_parameters(**params)
+    per = opts.runs_per_task
+    tasks = [keys[i:i + per] for i in range(0, len(keys), per)]
     chunk = max(1, max_array_size() - 1)
     submitted = {}
-    for i in range(0, len(keys), chunk):
-        part = keys[i:i + chunk]
+    for i in range(0, len(tasks), chunk):
+        part = tasks[i:i + chunk]
         with executor.batch():
-            handles = [executor.submit(RunJob(), str(root), k) for k in part]
-        submitted.update({k: h.job_id for k, h in zip(part, handles)})
+            handles = [executor.submit(RunJob(), str(root), t[0] if per == 1 else t) for t in part]
+        submitted.update({k: h.job_id for t, h in zip(part, handles) for k in t})
     jobs.update(submitted)
     write_json(root / "slurm" / "jobs.json", jobs)
     arrays = sorted({j.split("_")[0] for j in submitted.values()})
     log(f"submitted {len(submitted)} run(s) as array job(s) {', '.join(arrays)} "
-        f"({opts.parallelism} at a time, {opts.time} min, {opts.mem} each)")
+        f"({len(tasks)} task(s) of {per} run(s), {opts.parallelism} at a time, {opts.time} min, {opts.mem} each)")
     return submitted
 
 
