@@ -97,7 +97,10 @@ class Warm:
 
     def _read(self) -> None:
         for line in self.proc.stdout:
-            msg = json.loads(line)
+            try:
+                msg = json.loads(line)
+            except ValueError:      # not the server's (it answers on its own descriptor; kept safe anyway)
+                continue
             with self.lock:
                 run = self.runs.get(msg["id"])
                 if run is None:
@@ -248,13 +251,14 @@ def serve() -> None:
     import select
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)      # the sweep stops the runs; it closes stdin to end this
+    out = os.fdopen(os.dup(1), "w")                   # the answers; what an import prints goes to stderr
+    os.dup2(2, 1)
     _preload()
     wake_r, wake_w = os.pipe()
     os.set_blocking(wake_r, False)
     os.set_blocking(wake_w, False)
     signal.signal(signal.SIGCHLD, lambda *_: None)
     signal.set_wakeup_fd(wake_w)
-    out = sys.stdout
     children: dict[int, int] = {}
     buf, eof, fd = b"", False, sys.stdin.fileno()
 
@@ -282,7 +286,7 @@ def serve() -> None:
                 out.flush()
                 pid = os.fork()
                 if pid == 0:
-                    _child(req, (wake_r, wake_w))
+                    _child(req, (wake_r, wake_w, out.fileno()))
                 children[pid] = req["id"]
                 say({"id": req["id"], "pid": pid})
         while children:
