@@ -15,8 +15,7 @@ negative for a signal; user + system CPU seconds of the child and of what it wai
 
 :class:`WarmRun` is the sweep's handle of such a child, with the part of ``subprocess.Popen``'s interface that
 :func:`wendel.sweep.folders.execute` and :func:`~wendel.sweep.folders.stop_process` use (``pid``, ``wait``,
-``poll``, ``returncode``). ``WENDEL_SWEEP_WARM=0`` runs every run as a subprocess again; if the server cannot
-start or dies, the runs left fall back to subprocesses.
+``poll``, ``returncode``). ``WENDEL_SWEEP_WARM=0``: every run a subprocess, as when the server dies.
 """
 
 from __future__ import annotations
@@ -182,7 +181,6 @@ class _Child:
 
     def wait(self, timeout: float | None = None) -> int:
         import time
-
         end = None if timeout is None else time.monotonic() + timeout
         while self.poll() is None:
             if end is not None and time.monotonic() >= end:
@@ -210,7 +208,7 @@ def _preload() -> None:
 
 
 def _child(req: dict, keep: tuple[int, ...]) -> None:
-    """In the forked child: the run's session, output and arguments; never returns."""
+    """In the forked child (``keep``: the server's descriptors, closed): the run's session, output, arguments."""
     global FORKED
     code = 1
     try:
