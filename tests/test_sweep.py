@@ -255,7 +255,12 @@ def test_several_runs_in_one_slurm_task_are_forked_warm(tmp_path, slurm_cluster)
     assert jobs[keys[0]] == jobs[keys[1]] != jobs[keys[2]], jobs
     assert [r["status"] for r in rep["rows"]] == ["done"] * 3, (rep["rows"], [p.read_text()[-2000:] for p in
                                                                       (out / "slurm").rglob("*.out")])
-    warm = [json.loads((run_dir(out, k) / "sweep.json").read_text())["warm"] for k in keys]
+    records = [run_dir(out, k) / "sweep.json" for k in keys]     # written by the task after `wendel run` ended
+    deadline = time.time() + 60
+    while not all(p.is_file() for p in records):
+        assert time.time() < deadline, "the tasks wrote no sweep.json"
+        time.sleep(0.2)
+    warm = [json.loads(p.read_text())["warm"] for p in records]
     assert warm == [True, True, False], [(out / "logs" / f"{k}.log").read_text()[-2000:] for k in keys]
     bad = wendel("sweep", sweep, "--out", tmp_path / "bad", "--executor", "slurm", "--runs-per-task", "0")
     assert bad.returncode == 2 and "runs_per_task" in bad.stderr, bad.stderr
