@@ -88,59 +88,53 @@ def run_sweep(sweep_path: Path, out: Path | None = None, executor: str = "local"
     Every planned scene is validated first (:class:`wendel.scene.SceneError` before anything runs).
     """
     t0 = time.perf_counter()
+    from contextlib import closing, nullcontext
+
     from .warm import Warm, enabled
-    server = Warm() if executor == "local" and enabled() else None     # its imports overlap the planning
-    try:
-        return _run_sweep(t0, server, sweep_path, out, executor, workers, slurm, detach, quiet, log)
-    finally:
-        if server is not None:
-            server.close()
+    # the warm server's imports overlap the planning; it ends with the sweep
+    with closing(Warm()) if executor == "local" and enabled() else nullcontext() as server:
+        from .plan import load_sweep
 
+        sweep = load_sweep(sweep_path)
+        root = sweep_root(sweep_path, out)
+        plan = prepare(sweep, root)
+        states = {e["key"]: state(run_dir(root, e["key"]))[0] for e in plan["runs"]}
+        todo = [k for k, s in states.items() if s != DONE]
+        counts = Counter(states.values())
+        log(f"sweep {sweep.path.name}: {len(plan['runs'])} runs in {root}: {counts[DONE]} done, "
+            f"{counts[FAILED]} failed before (re-run), {counts[INTERRUPTED]} interrupted (resumed), "
+            f"{counts[PENDING] + counts[STALE]} to start")
+        report = {"root": root, "runs": len(plan["runs"]), "skipped": counts[DONE], "todo": len(todo)}
+        if todo and executor == "local":
+            from .local import default_workers, run_local
 
-def _run_sweep(t0, server, sweep_path, out, executor, workers, slurm, detach, quiet, log) -> dict:
-    from .plan import load_sweep
-
-    sweep = load_sweep(sweep_path)
-    root = sweep_root(sweep_path, out)
-    plan = prepare(sweep, root)
-    states = {e["key"]: state(run_dir(root, e["key"]))[0] for e in plan["runs"]}
-    todo = [k for k, s in states.items() if s != DONE]
-    counts = Counter(states.values())
-    log(f"sweep {sweep.path.name}: {len(plan['runs'])} runs in {root}: {counts[DONE]} done, "
-        f"{counts[FAILED]} failed before (re-run), {counts[INTERRUPTED]} interrupted (resumed), "
-        f"{counts[PENDING] + counts[STALE]} to start")
-    report = {"root": root, "runs": len(plan["runs"]), "skipped": counts[DONE], "todo": len(todo)}
-    if todo and executor == "local":
-        from .local import default_workers, run_local
-
-        lock = _lock(root)
-        jobs = read_json(root / "slurm" / "jobs.json")
-        if jobs and any(k in jobs for k in todo):       # run here now: earlier SLURM jobs no longer speak for them
-            write_json(root / "slurm" / "jobs.json", {k: v for k, v in jobs.items() if k not in todo})
-        n = workers or sweep.spec.workers or default_workers(max(r.ranks for r in sweep.runs))
-        try:
-            outcomes = run_local(root, todo, n, skipped=counts[DONE], quiet=quiet, warm=server)
-        finally:
-            lock.close()
-        report["outcomes"] = outcomes
-        report["workers"] = n
-    elif todo and executor == "slurm":
-        from . import slurm as slurm_exec
-
-        from .plan import Slurm
-        opts = Slurm.model_validate({**sweep.spec.slurm.model_dump(),       # the command line's values validated too
-                                     **{k: v for k, v in (slurm or {}).items() if v is not None}})
-        report["jobs"] = slurm_exec.submit(root, plan, todo, opts, log=log)
-        if not detach:
-            slurm_exec.wait(root, plan, quiet=quiet)
-    elif todo:
-        raise ValueError(f"unknown executor {executor!r}; valid: local, slurm")
-    report["wall"] = time.perf_counter() - t0
-    if not (executor == "slurm" and detach):
-        rows, csv_path, changed = collect_into(root, plan)
-        report["rows"] = rows
-        report["csv"] = csv_path
-    return report
+            lock = _lock(root)
+            jobs = read_json(root / "slurm" / "jobs.json")
+            if jobs and any(k in jobs for k in todo):       # run here now: earlier SLURM jobs no longer speak for them
+                write_json(root / "slurm" / "jobs.json", {k: v for k, v in jobs.items() if k not in todo})
+            n = workers or sweep.spec.workers or default_workers(max(r.ranks for r in sweep.runs))
+            try:
+                outcomes = run_local(root, todo, n, skipped=counts[DONE], quiet=quiet, warm=server)
+            finally:
+                lock.close()
+            report["outcomes"] = outcomes
+            report["workers"] = n
+        elif todo and executor == "slurm":
+            from . import slurm as slurm_exec
+            from .plan import Slurm
+            opts = Slurm.model_validate({**sweep.spec.slurm.model_dump(),       # the command line's values validated too
+                                         **{k: v for k, v in (slurm or {}).items() if v is not None}})
+            report["jobs"] = slurm_exec.submit(root, plan, todo, opts, log=log)
+            if not detach:
+                slurm_exec.wait(root, plan, quiet=quiet)
+        elif todo:
+            raise ValueError(f"unknown executor {executor!r}; valid: local, slurm")
+        report["wall"] = time.perf_counter() - t0
+        if not (executor == "slurm" and detach):
+            rows, csv_path, changed = collect_into(root, plan)
+            report["rows"] = rows
+            report["csv"] = csv_path
+        return report
 
 
 def _lock(root: Path):

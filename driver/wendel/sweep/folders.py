@@ -139,10 +139,10 @@ def execute(root: Path, key: str, on_start=None, stop: threading.Event | None = 
         flog.write(f"$ {' '.join(cmd)}\n")
         flog.flush()
         proc = warm.spawn(["run", *args], log) if warm is not None else None
-        if proc is None and warm is not None:
-            flog.write("(the warm server is gone: started as a subprocess)\n")
-            flog.flush()
         if proc is None:
+            if warm is not None:
+                flog.write("(the warm server is gone: started as a subprocess)\n")
+                flog.flush()
             proc = subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=flog, stderr=subprocess.STDOUT,
                                     start_new_session=True)
         if on_start is not None:

@@ -31,10 +31,6 @@ def run_local(root: Path, keys: list[str], workers: int, skipped: int = 0, quiet
     that server (:mod:`wendel.sweep.warm`; :func:`wendel.sweep.run_sweep` starts one unless
     ``WENDEL_SWEEP_WARM=0``), else each is a subprocess.
     """
-    return _run(root, keys, workers, skipped, quiet, warm)
-
-
-def _run(root: Path, keys: list[str], workers: int, skipped: int, quiet: bool, warm) -> list[dict]:
     from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 

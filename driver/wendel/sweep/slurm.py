@@ -34,13 +34,14 @@ class RunJob(submitit.helpers.Checkpointable):
     forked from a warm process, :mod:`wendel.sweep.warm`); requeued on timeout or preemption: the runs done are
     skipped, the interrupted one resumes from its checkpoint."""
 
-    def __call__(self, root: str, keys: str | list[str]) -> list[dict]:
+    def __call__(self, root: str, keys: list[str] | str) -> list[dict]:
+        from contextlib import closing, nullcontext
+
         from .warm import Warm, enabled
 
-        keys = [keys] if isinstance(keys, str) else keys
-        server = Warm() if len(keys) > 1 and enabled() else None
+        keys = [keys] if isinstance(keys, str) else keys    # a job submitted before runs_per_task, requeued
         results = []
-        try:
+        with closing(Warm()) if len(keys) > 1 and enabled() else nullcontext() as server:
             for key in keys:
                 results.append(execute(Path(root), key, killed_is_failure=False, warm=server))
                 if results[-1]["status"] == INTERRUPTED:
@@ -50,9 +51,6 @@ class RunJob(submitit.helpers.Checkpointable):
                     # for the signal and the requeue.
                     time.sleep(REQUEUE_WAIT)   # a signal's handler runs during it; the sleep then goes on (PEP 475)
                     break
-        finally:
-            if server is not None:
-                server.close()
         return results
 
 
@@ -92,7 +90,7 @@ def submit(root: Path, plan: dict, keys: list[str], opts, log=print) -> dict:
     for i in range(0, len(tasks), chunk):
         part = tasks[i:i + chunk]
         with executor.batch():
-            handles = [executor.submit(RunJob(), str(root), t[0] if per == 1 else t) for t in part]
+            handles = [executor.submit(RunJob(), str(root), t) for t in part]
         submitted.update({k: h.job_id for t, h in zip(part, handles) for k in t})
     jobs.update(submitted)
     write_json(root / "slurm" / "jobs.json", jobs)
