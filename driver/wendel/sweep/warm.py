@@ -10,8 +10,8 @@ one request per line (``{"id", "argv", "log", "cwd"}``) and forks; the child sta
 stops it by its process group, as a ``wendel run`` subprocess), points its output at the run's log and calls
 ``wendel.cli.main`` with the run's arguments; its own picture process is forked from it in turn
 (:func:`fork_painter`: the matplotlib imports are already there). The server reaps each child and answers
-``{"id", "pid"}`` when it is forked and ``{"id", "rc", "cpu"}`` when it ends (exit code as ``Popen``'s:
-negative for a signal; user + system CPU seconds of the child and of what it waited for).
+``{"id", "pid"}`` when it is forked and ``{"id", "rc"}`` when it ends (exit code as ``Popen``'s: negative for a
+signal).
 
 :class:`WarmRun` is the sweep's handle of such a child, with the part of ``subprocess.Popen``'s interface that
 :func:`wendel.sweep.folders.execute` and :func:`~wendel.sweep.folders.stop_process` use (``pid``, ``wait``,
@@ -42,13 +42,12 @@ def enabled() -> bool:
 
 class WarmRun:
     """A run forked by the server: ``pid`` (its process group too), ``wait(timeout)``, ``poll()``,
-    ``returncode`` and ``cpu`` (seconds) once it ended."""
+    ``returncode`` once it ended."""
 
     def __init__(self, args: list[str]):
         self.args = args
         self.pid: int | None = None
         self.returncode: int | None = None
-        self.cpu: float | None = None
         self.started = threading.Event()
         self.ended = threading.Event()
 
@@ -75,7 +74,7 @@ class Warm:
         self.alive = True
         threading.Thread(target=self._read, daemon=True).start()
 
-    def spawn(self, argv: list[str], log, cwd=None) -> WarmRun | None:
+    def spawn(self, argv: list[str], log) -> WarmRun | None:
         """Fork ``wendel <argv>`` with its output appended to ``log``; None when the server is gone (the caller
         starts a subprocess instead)."""
         with self.lock:
@@ -85,7 +84,7 @@ class Warm:
             run = self.runs[self.count] = WarmRun(["wendel", *argv])
             try:
                 self.proc.stdin.write(json.dumps({"id": self.count, "argv": argv, "log": str(log),
-                                                  "cwd": str(cwd or os.getcwd())}) + "\n")
+                                                  "cwd": os.getcwd()}) + "\n")
                 self.proc.stdin.flush()
             except (OSError, ValueError):
                 self.alive = False
@@ -108,7 +107,7 @@ class Warm:
                     run.pid = msg["pid"]
                     run.started.set()
                 else:
-                    run.returncode, run.cpu = msg["rc"], msg["cpu"]
+                    run.returncode = msg["rc"]
                     self.runs.pop(msg["id"])
                     run.ended.set()
         with self.lock:         # the server is gone: what it had not forked falls back, what it had is lost
@@ -289,12 +288,11 @@ def serve() -> None:
                 say({"id": req["id"], "pid": pid})
         while children:
             try:
-                pid, status, usage = os.wait4(-1, os.WNOHANG)
+                pid, status = os.waitpid(-1, os.WNOHANG)
             except ChildProcessError:
                 break
             if pid == 0:
                 break
             if pid in children:
-                say({"id": children.pop(pid), "rc": os.waitstatus_to_exitcode(status),
-                     "cpu": usage.ru_utime + usage.ru_stime})
+                say({"id": children.pop(pid), "rc": os.waitstatus_to_exitcode(status)})
 
