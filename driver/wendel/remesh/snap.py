@@ -175,18 +175,13 @@ def rewrite_nodes(path, points: np.ndarray) -> None:
     path.write_bytes(text[:a] + f"{n}\n{body}".encode() + text[b:])
 
 
-def tool_at(scene, inc_dir) -> dict | None:
+def tool_at(scene, inc_dir) -> dict:
     """The scene's rigid polygon tool (``contact.tool``: vertices and corner radii) where it stood at increment
-    ``inc_dir`` (``tool_x``, ``tool_y`` of its record.json); None for other obstacles, an STL tool or a turned one."""
-    c = scene.contact
-    if c is None or c.obstacle != "tool" or c.tool is None or c.tool.stl is not None or not c.tool.vertices:
-        return None
-    shift, angle = placement(inc_dir)
-    if abs(angle) > 0:
-        return None
-    v = np.asarray(c.tool.vertices, dtype=float)[:, :2] + shift[:2]
-    radii = list(c.tool.radii) if c.tool.radii else [0.0] * len(v)
-    return {"vertices": v, "radii": radii}
+    ``inc_dir`` (``tool_x``, ``tool_y`` of its record.json). For a scene with ``remesh.snap_to_tool``, which the
+    schema accepts only with a convex 2D polygon tool that does not turn (``wendel.scene.schema.check_snap``)."""
+    tool = scene.contact.tool
+    v = np.asarray(tool.vertices, dtype=float)[:, :2] + placement(inc_dir)[0][:2]
+    return {"vertices": v, "radii": list(tool.radii) if tool.radii else [0.0] * len(v)}
 
 
 def onto_tool(mesh: "Path", points: np.ndarray, cells: np.ndarray, tool: dict) -> tuple[np.ndarray, dict]:
