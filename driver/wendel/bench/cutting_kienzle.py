@@ -14,21 +14,41 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from . import WORKFLOWS, register
+from . import WORKFLOWS, env_flag, register
 
 SWEEP = WORKFLOWS / "campaigns" / "cutting-kienzle.toml"
 
 
 @register("cutting-kienzle")
 def cutting_kienzle(quick: bool, workdir: Path) -> list[dict]:
+    """``WENDEL_BENCH_FBAR=1``: every cut with F-bar (``"cutting.volumetric" = "fbar"`` added to the campaign's
+    ``[set]`` in a copy, results/bench/work/cutting-kienzle/cutting-kienzle-fbar.toml; sweep folder
+    results/sweeps/cutting-kienzle-fbar/, picture cutting-kienzle-fbar.png)."""
     from ..cutting import fe_campaign
     from ..sweep import run_sweep, sweep_root
 
+    sweep, tag = SWEEP, ""
+    if env_flag("WENDEL_BENCH_FBAR", '"cutting.volumetric" = "fbar" in the campaign'):
+        sweep, tag = _with_fbar(workdir), "-fbar"
     if not quick:
-        run_sweep(SWEEP, quiet=True, log=lambda *_: None)
-    root = sweep_root(SWEEP)
+        run_sweep(sweep, quiet=True, log=lambda *_: None)
+    root = sweep_root(sweep)
     cuts = fe_campaign.points(root)
     fits = fe_campaign.compare(cuts, "aisi1045")
-    fe_campaign.plot(workdir.parents[1] / "cutting-kienzle.png", cuts, fits,
-                     "AISI 1045: FE cuts (edge r/2, last h of 2.67 h) against Oxley, catalogues")
+    fe_campaign.plot(workdir.parents[1] / f"cutting-kienzle{tag}.png", cuts, fits,
+                     f"AISI 1045: FE cuts (edge r/2{', F-bar' if tag else ''}, last h of 2.67 h) against Oxley, catalogues")
     return [{"kind": "cut", **r} for r in cuts] + [{"kind": "fit", **f} for f in fits]
+
+
+def _with_fbar(workdir: Path) -> Path:
+    """A copy of the campaign with F-bar in its ``[set]`` and its scene path made absolute."""
+    import tomllib
+
+    import tomli_w
+    d = tomllib.loads(SWEEP.read_text())
+    d["scene"] = str((SWEEP.parent / d["scene"]).resolve())
+    d["set"]["cutting.volumetric"] = "fbar"
+    workdir.mkdir(parents=True, exist_ok=True)
+    out = workdir / "cutting-kienzle-fbar.toml"
+    out.write_text(tomli_w.dumps(d))
+    return out

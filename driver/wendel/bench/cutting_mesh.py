@@ -154,12 +154,15 @@ def _case(name: str, divide: int, substeps: int, quick: bool, workdir: Path, vol
 
 @register("cutting-mesh")
 def cutting_mesh_bench(quick: bool, workdir: Path) -> list[dict]:
-    """Three edge resolutions and two steps of the steel cut (see the module; 50-60 minutes, quick 10)."""
+    """Three edge resolutions and two steps of the steel cut (see the module; 50-60 minutes, quick 10).
+    ``WENDEL_BENCH_FBAR=1``: every case with F-bar (``cutting.volumetric = "fbar"``; case folders ``...-F-bar``)."""
     from ..cutting.scene import predict
     workdir.mkdir(parents=True, exist_ok=True)
+    fbar = env_flag("WENDEL_BENCH_FBAR", 'cutting.volumetric = "fbar"')
     rows = []
     for name, divide, substeps in CASES:
-        rows.append(_case(name, divide, substeps, quick, workdir))
+        rows.append(_case(name + (", F-bar" if fbar else ""), divide, substeps, quick, workdir,
+                          "fbar" if fbar else "cell"))
         (workdir / "partial.json").write_text(json.dumps(rows, indent=1))     # a long bench that stops keeps its cases
     by = {(r["edge_size_um"], r["step_um"]): r for r in rows}
     finest = min(r["edge_size_um"] for r in rows)
