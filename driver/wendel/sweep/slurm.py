@@ -139,7 +139,8 @@ def job_states(job_ids: list[str]) -> dict[str, str]:
 
 def reconcile(root: Path, plan: dict) -> dict[str, str]:
     """Compare the folders with the scheduler: record killed jobs as failed; return {key: queued|running}
-    for the runs whose job is alive."""
+    for the runs whose job is alive (a complete run too, until its task has written its sweep.json, so that a
+    table collected when nothing is live has every run's ``run_wall``)."""
     jobs = read_json(root / "slurm" / "jobs.json") or {}
     planned = {e["key"] for e in plan["runs"]}
     jobs = {k: j for k, j in jobs.items() if k in planned}
@@ -147,9 +148,12 @@ def reconcile(root: Path, plan: dict) -> dict[str, str]:
     live = {}
     for key, job in jobs.items():
         status, _ = state(run_dir(root, key))
+        s = states.get(job)
+        if status == DONE and s in LIVE and (read_json(run_dir(root, key) / "sweep.json") or {}).get("status") != DONE:
+            live[key] = "running"       # complete, but its task has not yet written sweep.json (the run's wall time)
+            continue
         if status in (DONE, FAILED):
             continue
-        s = states.get(job)
         if s in LIVE:
             live[key] = "queued" if s in ("PENDING", "REQUEUED", "REQUEUE_HOLD") else "running"
         elif s == "COMPLETED":
