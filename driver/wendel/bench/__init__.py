@@ -44,6 +44,17 @@ def env_flag(name: str, what: str) -> bool:
     return v == "1"
 
 
+def volumetric(default: str) -> str:
+    """The cutting benches' ``cutting.volumetric`` from ``WENDEL_BENCH_FBAR``: 1 F-bar (``"fbar"``), 0 the P1 cell's
+    own volume change (``"cell"``), unset ``default`` (the scene's: both cutting scenes say ``"cell"``); anything else refused by name."""
+    v = os.environ.get("WENDEL_BENCH_FBAR")
+    if v is None:
+        return default
+    if v not in ("0", "1"):
+        raise ValueError(f"WENDEL_BENCH_FBAR = {v!r}: 1 (cutting.volumetric = \"fbar\"), 0 (\"cell\") or unset (as the scene says)")
+    return "fbar" if v == "1" else "cell"
+
+
 def register(name: str):
     """Register a benchmark ``func(quick, workdir) -> rows`` under ``name``."""
 

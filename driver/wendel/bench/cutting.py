@@ -6,7 +6,8 @@ Each case runs ``workflows/cutting-aisi1045.toml`` (``--quick``: its first 20 in
 far as it got, with the reason. Per case: increments and tool travel reached, F_c and F_t at the end and
 their mean over the last 20 um of travel, the chip rise, contact length and chip thickness, the largest
 plastic strain (and temperature), the wall time and the share of remeshing + transfer, beside the Oxley
-prediction of the same scene.
+prediction of the same scene. ``WENDEL_BENCH_FBAR``: 1 or 0 sets ``cutting.volumetric`` (``"fbar"``, ``"cell"``)
+instead of the scene's.
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ import shutil
 import time
 from pathlib import Path
 
-from . import WORKFLOWS, register
+from . import WORKFLOWS, register, volumetric
 
 
 def _case(name: str, scene_path: Path, workdir: Path, steps: int | None) -> dict:
@@ -27,6 +28,7 @@ def _case(name: str, scene_path: Path, workdir: Path, steps: int | None) -> dict
     from ..scene import load
 
     scene = load(scene_path)
+    scene.cutting.volumetric = volumetric(scene.cutting.volumetric)
     if name == "isothermal":
         scene.thermal.beta = 0.0      # adiabatic without Taylor-Quinney heat: the cut stays at T_room
     if steps:

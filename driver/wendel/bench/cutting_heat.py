@@ -6,6 +6,7 @@ The steel scene ``workflows/cutting-aisi1045.toml`` on the graded mesh at edge s
 the heat equation (``thermal.coupling`` = :data:`CONDUCTION`: conduction on the current body, the Taylor-Quinney
 heat and ``cutting.heat_to_chip`` of the rake face's frictional work, every boundary insulated). ``--quick``
 runs the monolithic coupling as well; the full bench runs both once more with k and c at :data:`PROPERTIES_T`.
+The scene's ``cutting.volumetric`` (the P1 cell's own); ``WENDEL_BENCH_FBAR=1``: F-bar, 0: the cell's.
 
 Per case: the window of the last 160 um of travel (``cutting-mesh``'s :func:`wendel.bench.cutting_mesh.measure`:
 F_c, F_t and chip thickness weighted by travel, and their remesh-cycle spreads), the largest temperatures of the
@@ -28,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import WORKFLOWS, env_flag, register
+from . import WORKFLOWS, env_flag, register, volumetric
 from .cutting_mesh import WINDOW, _finished, _scene, measure
 
 CONDUCTION = "staggered"
@@ -47,6 +48,7 @@ def _case(coupling: str, quick: bool, workdir: Path, properties_T: float | None 
 
     if scene is None:
         scene = _scene(2, 1, quick)
+        scene.cutting.volumetric = volumetric(scene.cutting.volumetric)
     scene.thermal.coupling = coupling
     scene.cutting.fe_properties_T = properties_T
     name = name or (coupling if properties_T is None else f"{coupling}-{properties_T - 273.15:.0f}C")
@@ -119,8 +121,8 @@ def cutting_ti_bench(quick: bool, workdir: Path) -> list[dict]:
     the forces and the chip thickness over the last 160 um, beside Oxley (about 10 minutes).
     ``WENDEL_BENCH_CUT_MM``: a longer cut [mm] (0.4 to 20) on a block 0.6 mm longer than the cut (folder
     ``ti-r2-<um>um``), with the steady-state detector's spreads and drifts over the last h (``cutting-steady``'s).
-    ``WENDEL_BENCH_SNAP=1``: with ``cutting.snap_to_tool`` (folder ``...-snap``); ``WENDEL_BENCH_FBAR=1``: with
-    ``cutting.volumetric = "fbar"`` (folder ``...-fbar``)."""
+    ``WENDEL_BENCH_SNAP=1``: with ``cutting.snap_to_tool`` (folder ``...-snap``). ``WENDEL_BENCH_FBAR=1``: with
+    ``cutting.volumetric = "fbar"`` (folder ``...-fbar``), 0 or unset: as the scene says (the P1 cell's own)."""
     import os
 
     from ..cutting.scene import predict
@@ -136,9 +138,8 @@ def cutting_ti_bench(quick: bool, workdir: Path) -> list[dict]:
         scene.geometry.model_extra["length"] = scene.cutting.cut_length + 0.6e-3
     snap = env_flag("WENDEL_BENCH_SNAP", "cutting.snap_to_tool")
     scene.cutting.snap_to_tool = scene.cutting.snap_to_tool or snap
-    fbar = env_flag("WENDEL_BENCH_FBAR", 'cutting.volumetric = "fbar"')
-    if fbar:
-        scene.cutting.volumetric = "fbar"
+    scene.cutting.volumetric = volumetric(scene.cutting.volumetric)
+    fbar = scene.cutting.volumetric == "fbar"
     if quick:
         scene.cutting.cut_length *= 20 / scene.loading.steps
         scene.loading.steps = 20

@@ -14,41 +14,45 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from . import WORKFLOWS, env_flag, register
+from . import WORKFLOWS, register, volumetric
 
 SWEEP = WORKFLOWS / "campaigns" / "cutting-kienzle.toml"
 
 
 @register("cutting-kienzle")
 def cutting_kienzle(quick: bool, workdir: Path) -> list[dict]:
-    """``WENDEL_BENCH_FBAR=1``: every cut with F-bar (``"cutting.volumetric" = "fbar"`` added to the campaign's
-    ``[set]`` in a copy, results/bench/work/cutting-kienzle/cutting-kienzle-fbar.toml; sweep folder
-    results/sweeps/cutting-kienzle-fbar/, picture cutting-kienzle-fbar.png)."""
+    """The campaign as written (its scene's plain P1 cells); ``WENDEL_BENCH_FBAR`` 1 or 0: a copy with
+    ``"cutting.volumetric"`` = ``"fbar"`` or ``"cell"`` in its ``[set]`` (results/bench/work/cutting-kienzle/
+    cutting-kienzle-<fbar|cell>.toml; sweep folder results/sweeps/cutting-kienzle-<fbar|cell>/, picture
+    cutting-kienzle-<fbar|cell>.png)."""
+    import os
+
     from ..cutting import fe_campaign
     from ..sweep import run_sweep, sweep_root
 
     sweep, tag = SWEEP, ""
-    if env_flag("WENDEL_BENCH_FBAR", '"cutting.volumetric" = "fbar" in the campaign'):
-        sweep, tag = _with_fbar(workdir), "-fbar"
+    if "WENDEL_BENCH_FBAR" in os.environ:
+        vol = volumetric("")
+        sweep, tag = _with_volumetric(workdir, vol), f"-{vol}"
     if not quick:
         run_sweep(sweep, quiet=True, log=lambda *_: None)
     root = sweep_root(sweep)
     cuts = fe_campaign.points(root)
     fits = fe_campaign.compare(cuts, "aisi1045")
     fe_campaign.plot(workdir.parents[1] / f"cutting-kienzle{tag}.png", cuts, fits,
-                     f"AISI 1045: FE cuts (edge r/2{', F-bar' if tag else ''}, last h of 2.67 h) against Oxley, catalogues")
+                     f"AISI 1045: FE cuts (edge r/2{', ' + tag[1:] if tag else ''}, last h of 2.67 h) against Oxley, catalogues")
     return [{"kind": "cut", **r} for r in cuts] + [{"kind": "fit", **f} for f in fits]
 
 
-def _with_fbar(workdir: Path) -> Path:
-    """A copy of the campaign with F-bar in its ``[set]`` and its scene path made absolute."""
+def _with_volumetric(workdir: Path, vol: str) -> Path:
+    """A copy of the campaign with ``"cutting.volumetric" = vol`` in its ``[set]`` and its scene path made absolute."""
     import tomllib
 
     import tomli_w
     d = tomllib.loads(SWEEP.read_text())
     d["scene"] = str((SWEEP.parent / d["scene"]).resolve())
-    d["set"]["cutting.volumetric"] = "fbar"
+    d["set"]["cutting.volumetric"] = vol
     workdir.mkdir(parents=True, exist_ok=True)
-    out = workdir / "cutting-kienzle-fbar.toml"
+    out = workdir / f"cutting-kienzle-{vol}.toml"
     out.write_text(tomli_w.dumps(d))
     return out

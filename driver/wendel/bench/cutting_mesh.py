@@ -32,7 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import WORKFLOWS, env_flag, register
+from . import WORKFLOWS, env_flag, register, volumetric
 
 WINDOW = 160e-6  # m: the compared window, the last 160 um of travel (4 remesh cycles of 40 um without step cuts)
 STEPS = 80       # increments of 5 um: the first 400 um (2.7 h) of the scene's 600 um cut
@@ -40,11 +40,12 @@ CASES = [("r/2", 2, 1), ("r/4", 4, 1), ("r/3", 3, 1), ("r/2, half step", 2, 2)]
 """(name, edge radius / edge size, increments per 5 um)."""
 
 
-def _scene(divide: int, substeps: int, quick: bool, volumetric: str = "cell"):
+def _scene(divide: int, substeps: int, quick: bool, volumetric: str | None = None):
+    """The steel scene at edge r / ``divide``, ``substeps`` increments per 5 um, ``volumetric`` or its own."""
     from ..scene import load
     scene = load(WORKFLOWS / "cutting-aisi1045.toml")
     c = scene.cutting
-    c.volumetric = volumetric
+    c.volumetric = volumetric or c.volumetric
     steps = 20 if quick else STEPS
     c.cut_length *= steps / scene.loading.steps
     scene.loading.steps = steps
@@ -116,7 +117,7 @@ def sawtooth(out: Path) -> dict:
             "mean_stress_abs_after_max": max(after)}
 
 
-def _case(name: str, divide: int, substeps: int, quick: bool, workdir: Path, volumetric: str = "cell") -> dict:
+def _case(name: str, divide: int, substeps: int, quick: bool, workdir: Path, volumetric: str | None = None) -> dict:
     import csv
 
     from ..cutting.fe_run import run_cut
@@ -145,7 +146,7 @@ def _case(name: str, divide: int, substeps: int, quick: bool, workdir: Path, vol
     s = json.loads((out / "summary.json").read_text())
     remesh = sum(r.get("remesh_seconds", 0) + r.get("transfer_seconds", 0) for r in s["remeshes"])
     c = scene.cutting
-    return {"case": name, "volumetric": volumetric, "edge_size_um": c.edge_size * 1e6, "step_um": c.cut_length / scene.loading.steps * 1e6,
+    return {"case": name, "volumetric": c.volumetric, "edge_size_um": c.edge_size * 1e6, "step_um": c.cut_length / scene.loading.steps * 1e6,
             "travel_um": rows[-1]["tool_travel_m"] * 1e6, "increments": s["increments"],
             "elements_max": int(max(r["elements"] for r in rows)), "remeshes": len(s["remeshes"]),
             "newton_iterations": s["newton_iterations"], **measure(rows), **sawtooth(out), "wall_s": wall,
@@ -154,15 +155,14 @@ def _case(name: str, divide: int, substeps: int, quick: bool, workdir: Path, vol
 
 @register("cutting-mesh")
 def cutting_mesh_bench(quick: bool, workdir: Path) -> list[dict]:
-    """Three edge resolutions and two steps of the steel cut (see the module; 50-60 minutes, quick 10).
-    ``WENDEL_BENCH_FBAR=1``: every case with F-bar (``cutting.volumetric = "fbar"``; case folders ``...-F-bar``)."""
+    """Three edge resolutions and two steps of the steel cut (see the module; 50-60 minutes, quick 10);
+    ``WENDEL_BENCH_FBAR=1``: every case with F-bar (case folders ``...-F-bar``)."""
     from ..cutting.scene import predict
     workdir.mkdir(parents=True, exist_ok=True)
-    fbar = env_flag("WENDEL_BENCH_FBAR", 'cutting.volumetric = "fbar"')
+    vol = volumetric(_scene(2, 1, quick).cutting.volumetric)
     rows = []
     for name, divide, substeps in CASES:
-        rows.append(_case(name + (", F-bar" if fbar else ""), divide, substeps, quick, workdir,
-                          "fbar" if fbar else "cell"))
+        rows.append(_case(name + (", F-bar" if vol == "fbar" else ""), divide, substeps, quick, workdir, vol))
         (workdir / "partial.json").write_text(json.dumps(rows, indent=1))     # a long bench that stops keeps its cases
     by = {(r["edge_size_um"], r["step_um"]): r for r in rows}
     finest = min(r["edge_size_um"] for r in rows)
@@ -181,8 +181,7 @@ def cutting_fbar_bench(quick: bool, workdir: Path) -> list[dict]:
     """The middle resolution of ``cutting-mesh`` (edge r/2) with F-bar (``cutting.volumetric = "fbar"``) beside
     the same case without it (each in this bench's own folder)."""
     workdir.mkdir(parents=True, exist_ok=True)
-    rows = [_case("r/2", 2, 1, quick, workdir),
-            _case("r/2, F-bar", 2, 1, quick, workdir, "fbar")]
+    rows = [_case("r/2", 2, 1, quick, workdir, "cell"), _case("r/2, F-bar", 2, 1, quick, workdir, "fbar")]
     rows[1]["dFc_vs_cell"] = (rows[1]["Fc_last"] - rows[0]["Fc_last"]) / rows[0]["Fc_last"]
     return rows
 
@@ -237,16 +236,15 @@ def cutting_long_bench(quick: bool, workdir: Path) -> list[dict]:
     return _steady(quick, workdir, "cell", length=mm * 1e-3, block=(mm + 1.4) * 1e-3, folder=f"r2-{mm * 1e3:.0f}um")
 
 
-def _steady(quick: bool, workdir: Path, volumetric: str, remesh_every: int | None = None,
+def _steady(quick: bool, workdir: Path, vol: str, remesh_every: int | None = None,
             length: float = 1.2e-3, block: float = 2.6e-3, folder: str | None = None) -> list[dict]:
     """The 1.2 mm cut of ``cutting-steady`` (or ``length`` [m] on a block ``block`` [m] long, in ``folder``) with
-    ``volumetric`` (and ``remesh_every`` increments between remeshes instead of the scene's 8, if given): the
-    remesh-cycle means, then one row of the last window's spreads and drifts, the increments, step cuts, Newton
-    iterations and the wall time."""
+    ``vol`` (and ``remesh_every`` increments between remeshes instead of the scene's 8, if given): the remesh-cycle
+    means, then a row of the last window's spreads and drifts, increments, step cuts, Newton iterations, wall time."""
     import csv
 
     from ..cutting.fe_steady import steady, window
-    scene = _scene(2, 1, quick=False, volumetric=volumetric)
+    scene = _scene(2, 1, quick=False, volumetric=vol)
     folder = folder or ("r2-long" if not remesh_every else f"r2-long-remesh{remesh_every}")
     if env_flag("WENDEL_BENCH_SNAP", "cutting.snap_to_tool"):
         scene.cutting.snap_to_tool, folder = True, folder + "-snap"
@@ -296,7 +294,7 @@ def _steady(quick: bool, workdir: Path, volumetric: str, remesh_every: int | Non
                 **{f"spread_{k}": v for k, v in st["last_window_spreads"]["cycles"].items()},
                 **{f"drift_{k}": v for k, v in st["last_window_trends"]["cycles"].items()},
                 **{f"inc_spread_{k}": v for k, v in st["last_window_spreads"]["raw"].items()},
-                "volumetric": volumetric, "increments": s.get("increments"), "step_cuts": s.get("step_cuts"),
+                "volumetric": vol, "increments": s.get("increments"), "step_cuts": s.get("step_cuts"),
                 "newton_iterations": s.get("newton_iterations"), "remeshes": len(s.get("remeshes", [])),
                 "wall_s": wall, "stopped": stopped})
     return res
