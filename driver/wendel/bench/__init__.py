@@ -44,7 +44,7 @@ def env_flag(name: str, what: str) -> bool:
     return v == "1"
 
 
-def volumetric(default: str) -> str:
+def volumetric(default: str | None) -> str | None:
     """The cutting benches' ``cutting.volumetric`` from ``WENDEL_BENCH_FBAR``: 1 F-bar (``"fbar"``), 0 the P1 cell's
     own volume change (``"cell"``), unset ``default`` (the scene's: both cutting scenes say ``"cell"``); anything else refused by name."""
     v = os.environ.get("WENDEL_BENCH_FBAR")

@@ -25,14 +25,12 @@ def cutting_kienzle(quick: bool, workdir: Path) -> list[dict]:
     ``"cutting.volumetric"`` = ``"fbar"`` or ``"cell"`` in its ``[set]`` (results/bench/work/cutting-kienzle/
     cutting-kienzle-<fbar|cell>.toml; sweep folder results/sweeps/cutting-kienzle-<fbar|cell>/, picture
     cutting-kienzle-<fbar|cell>.png)."""
-    import os
-
     from ..cutting import fe_campaign
     from ..sweep import run_sweep, sweep_root
 
     sweep, tag = SWEEP, ""
-    if "WENDEL_BENCH_FBAR" in os.environ:
-        vol = volumetric("")
+    vol = volumetric(None)          # None: the campaign as written
+    if vol:
         sweep, tag = _with_volumetric(workdir, vol), f"-{vol}"
     if not quick:
         run_sweep(sweep, quiet=True, log=lambda *_: None)

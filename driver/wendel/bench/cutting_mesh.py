@@ -40,12 +40,12 @@ CASES = [("r/2", 2, 1), ("r/4", 4, 1), ("r/3", 3, 1), ("r/2, half step", 2, 2)]
 """(name, edge radius / edge size, increments per 5 um)."""
 
 
-def _scene(divide: int, substeps: int, quick: bool, volumetric: str | None = None):
-    """The steel scene at edge r / ``divide``, ``substeps`` increments per 5 um, ``volumetric`` or its own."""
+def _scene(divide: int, substeps: int, quick: bool, vol: str | None = None):
+    """The steel scene at edge r / ``divide``, ``substeps`` increments per 5 um, ``cutting.volumetric`` ``vol`` or its own."""
     from ..scene import load
     scene = load(WORKFLOWS / "cutting-aisi1045.toml")
     c = scene.cutting
-    c.volumetric = volumetric or c.volumetric
+    c.volumetric = vol or c.volumetric
     steps = 20 if quick else STEPS
     c.cut_length *= steps / scene.loading.steps
     scene.loading.steps = steps
@@ -117,14 +117,14 @@ def sawtooth(out: Path) -> dict:
             "mean_stress_abs_after_max": max(after)}
 
 
-def _case(name: str, divide: int, substeps: int, quick: bool, workdir: Path, volumetric: str | None = None) -> dict:
+def _case(name: str, divide: int, substeps: int, quick: bool, workdir: Path, vol: str | None = None) -> dict:
     import csv
 
     from ..cutting.fe_run import run_cut
     from ..errors import StepCutError
     from ..freefem import FreeFemError, NewtonFailure
 
-    scene = _scene(divide, substeps, quick, volumetric)
+    scene = _scene(divide, substeps, quick, vol)
     out = workdir / name.replace("/", "").replace(", ", "-").replace(" ", "-")
     stopped, wall = "", float("nan")
     if _finished(out, scene):
@@ -244,7 +244,7 @@ def _steady(quick: bool, workdir: Path, vol: str, remesh_every: int | None = Non
     import csv
 
     from ..cutting.fe_steady import steady, window
-    scene = _scene(2, 1, quick=False, volumetric=vol)
+    scene = _scene(2, 1, quick=False, vol=vol)
     folder = folder or ("r2-long" if not remesh_every else f"r2-long-remesh{remesh_every}")
     if env_flag("WENDEL_BENCH_SNAP", "cutting.snap_to_tool"):
         scene.cutting.snap_to_tool, folder = True, folder + "-snap"
