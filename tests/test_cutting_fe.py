@@ -128,34 +128,3 @@ def test_fe_cut_fbar_compiled_patch_term_is_the_freefem_one(tmp_path):
         a = [float(r["residual"]) for r in csv.DictReader((root / "fem" / inc / "newton.csv").open())]
         b = [float(r["residual"]) for r in csv.DictReader((out / inc / "newton.csv").open())]
         assert len(a) == len(b) >= 2 and max(abs(x - y) for x, y in zip(a, b)) < 1e-9 * max(a), (inc, a, b)
-
-
-@pytest.mark.parametrize("volumetric", ["fbar", "cell"])
-def test_a_failed_fbar_reequilibration_is_tried_once_more_with_the_cells_own_volume_change(tmp_path, volumetric):
-    # F-bar's re-equilibration on a fine edge mesh failed in every number of stages (r/4 at 251 um, session 18:
-    # unlocked plastic flow under the edge, Newton steps of 34 um against 5 um cells); after the most stages the
-    # driver re-equilibrates that increment alone with the cells' own volume change (F-bar again from the next,
-    # quasistatic.solve), at the scene's stages; without F-bar (or after that try) it meshes the body again.
-    from wendel import freefem
-    from wendel.loop.checkpoint import RunFiles, State
-    from wendel.loop.steps import RELAX_MAX, cut_step
-    scene = load(STEEL, smoke=True)
-    scene.cutting.volumetric = volumetric
-    scene = fe_scene(scene)
-    rep = {"after_increment": 7, "relax_steps": RELAX_MAX, "dimension": 3}   # 3D: remesh_again has no other mesh
-    state = State(accepted=[(7, 0.5)], pending=[0.5, 0.6], reequilibrate=True, remeshes=[rep],
-                  segments=[{"first": 1, "mesh": "mesh.msh"}, {"first": 8, "mesh": "m.msh", "state": "s"}])
-    files = RunFiles(tmp_path)
-    failure = freefem.NewtonFailure({"increment": 8, "load_factor": 0.5, "reason": "mesh would invert"})
-    said = []
-    if volumetric == "cell":          # no other try: the step cannot be cut either (the same load factor)
-        with pytest.raises(Exception, match="mesh would invert"):
-            cut_step(scene, files, state, failure, said.append)
-        assert "relax_cell" not in rep
-        return
-    cut_step(scene, files, state, failure, said.append)
-    assert rep["relax_cell"] is True and rep["relax_steps"] == scene.remesh.relax_steps
-    assert state.pending == [0.5, 0.6] and state.cuts == 1 and "cells' own volume change" in said[-1]
-    rep["relax_steps"] = RELAX_MAX    # that failed in the most stages too: no third way on this mesh
-    with pytest.raises(Exception, match="mesh would invert"):
-        cut_step(scene, files, state, failure, said.append)

@@ -56,17 +56,6 @@ def cut_step(scene: Scene, files: RunFiles, state: State, failure: freefem.Newto
             state.cuts += 1
             progress(f"  increment {inc}: {reason} in the re-equilibration; again in {stages} stages")
             return
-        if scene.kinematics.volumetric == "fbar" and not rep.get("relax_cell"):
-            # F-bar's re-equilibration on a fine edge mesh: unlocked, nearly perfectly plastic flow gives Newton
-            # steps of several cells under the edge (measured at r/4: 34 um against cells of 5 um) while the
-            # friction sets change; the cells' own volume change (locking, stiffer) releases the out-of-balance
-            # in this one increment, and F-bar goes on from the next
-            rep["relax_cell"] = True
-            rep["relax_steps"] = scene.remesh.relax_steps
-            state.cuts += 1
-            progress(f"  increment {inc}: {reason} in the re-equilibration; again with the cells' own volume change "
-                     f"(F-bar from the next increment)")
-            return
         from ..remesh.again import remesh_again
         if remesh_again(scene, files, state, progress):      # another mesh of the same body
             state.cuts += 1
