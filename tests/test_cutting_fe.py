@@ -128,3 +128,24 @@ def test_fe_cut_fbar_compiled_patch_term_is_the_freefem_one(tmp_path):
         a = [float(r["residual"]) for r in csv.DictReader((root / "fem" / inc / "newton.csv").open())]
         b = [float(r["residual"]) for r in csv.DictReader((out / inc / "newton.csv").open())]
         assert len(a) == len(b) >= 2 and max(abs(x - y) for x, y in zip(a, b)) < 1e-9 * max(a), (inc, a, b)
+
+
+@pytest.mark.parametrize("volumetric", ["fbar", "cell"])
+def test_an_fbar_cut_that_tangles_stops_with_what_to_change(tmp_path, volumetric):
+    # The last step cut of a failing increment stops the run; when F-bar tangled the mesh the message says which
+    # keys go on (README "F-bar on fine edge meshes, traced"); with the cells' own volume change it does not.
+    from wendel import freefem
+    from wendel.errors import StepCutError
+    from wendel.loop.checkpoint import RunFiles, State
+    from wendel.loop.steps import cut_step
+    scene = load(STEEL, smoke=True)
+    scene.cutting.volumetric = volumetric
+    scene = fe_scene(scene)
+    lf = 0.5 + scene.loading.nominal_step() / 2 ** (scene.loading.max_cuts + 1)      # no halving left
+    state = State(accepted=[(7, 0.5)], pending=[lf])
+    failure = freefem.NewtonFailure({"increment": 8, "load_factor": lf, "reason": "mesh would invert"})
+    with pytest.raises(StepCutError) as err:
+        cut_step(scene, RunFiles(tmp_path), state, failure, lambda *_: None)
+    text = str(err.value)
+    assert "mesh would invert, even after" in text and "1 accepted increments are kept" in text
+    assert ("cutting.edge_size" in text and 'volumetric = "cell"' in text) == (volumetric == "fbar")

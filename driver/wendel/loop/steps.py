@@ -73,10 +73,23 @@ def cut_step(scene: Scene, files: RunFiles, state: State, failure: freefem.Newto
         raise StepCutError(
             f"increment {inc} (load factor {lf_prev:g} -> {lf_fail:g}): {what} between load factor {lf_prev:g} "
             f"(last converged) and {lf_fail:g} (first failed); "
-            f"{len(state.accepted)} accepted increments are kept in {files.root}")
+            f"{len(state.accepted)} accepted increments are kept in {files.root}" + _hint(scene, reason))
     if scene.loading.adaptive:
         state.step = abs(mid - lf_prev)
         if all(abs(lf_fail - t) > 1e-12 * max(1.0, abs(t)) for t in scene.loading.load_factors()):
             state.pending.pop(0)         # an intermediate point of the adaptive loading: plan_step re-plans
     state.pending.insert(0, mid)
     progress(f"  increment {inc}: {reason} at load factor {lf_fail:g}; cutting the step to {mid:g}")
+
+
+def _hint(scene: Scene, reason: str) -> str:
+    """What a user can change when F-bar tangles the mesh (measured on the FE cut, README "F-bar on fine edge
+    meshes, traced"): its vertex patches leave the small cells of a fully plastic zone to the plastic tangent
+    alone, and the finer the mesh there, the sooner a Newton step turns one inside out."""
+    if reason != "mesh would invert" or getattr(scene.kinematics, "volumetric", "cell") != "fbar":
+        return ""
+    return ("; F-bar (kinematics.volumetric, in a cutting scene cutting.volumetric = \"fbar\") inverts cells "
+            "so where many small ones flow plastically: coarser cells there (at a cutting edge cutting.edge_size "
+            "r/2 or more: r/3 and r/4 stopped in wendel bench cutting-mesh) or volumetric = \"cell\" (P1 locks: "
+            "stiffer, but it goes on)")
+
