@@ -40,6 +40,15 @@ def relaunch(root: Path, out: Path, *extra: str) -> Path:
     return out
 
 
+def fd_differences(root: Path, out: Path) -> tuple[list[float], list[float]]:
+    """The run's launch again with the finite-difference check into ``out``: the relative differences along the
+    Newton steps and in random directions (past each increment's start)."""
+    fd = rows(relaunch(root, out, "-newton_fd_check", "1e-6") / "fdcheck.csv")
+    newton = [float(r["relative_difference"]) for r in fd if r["direction"] == "newton"]
+    random = [float(r["relative_difference"]) for r in fd if r["direction"] == "random" and r["iteration"] != "0"]
+    return newton, random
+
+
 @pytest.mark.parametrize("volumetric", ["cell", "fbar"])
 def test_3d_tangent_matches_the_residual_differences_at_a_deformed_plastic_state(scene_file, tmp_path, quiet,
                                                                                  volumetric):
@@ -75,10 +84,7 @@ def test_2d_tangent_is_the_residual_derivative_in_every_direction(tmp_path, quie
     # 2e-9 and 5e-10 at most; with the Jaumann spin and sym grad standing for them the random direction
     # differed by up to 1.4e-3 on the plane-strain block)
     root = run(WORKFLOWS / f"{name}.toml", smoke=True, out=tmp_path / "run", progress=quiet, png=False)
-    out = relaunch(root, tmp_path / "fd", "-newton_fd_check", "1e-6")
-    fd = rows(out / "fdcheck.csv")
-    newton = [float(r["relative_difference"]) for r in fd if r["direction"] == "newton"]
-    random = [float(r["relative_difference"]) for r in fd if r["direction"] == "random" and r["iteration"] != "0"]
+    newton, random = fd_differences(root, tmp_path / "fd")
     assert len(newton) >= 10 and len(random) == len(newton)
     assert max(newton) < 1e-7 and max(random) < 1e-7
 
@@ -125,12 +131,10 @@ def test_plane_strain_fbar_tangent_is_the_residual_derivative_on_an_inhomogeneou
     # Newton steps and 3e-8 in random directions (session 19, while tracing the F-bar cut's inversions at the
     # tool's edge: the tangent is not their cause)
     root = run(scene_file(BARREL, "barrel.toml"), out=tmp_path / "run", progress=quiet, png=False)
-    out = relaunch(root, tmp_path / "fd", "-newton_fd_check", "1e-6")
-    fd = rows(out / "fdcheck.csv")
-    newton = [float(r["relative_difference"]) for r in fd if r["direction"] == "newton"]
-    random = [float(r["relative_difference"]) for r in fd if r["direction"] == "random" and r["iteration"] != "0"]
+    newton, random = fd_differences(root, tmp_path / "fd")
     assert len(newton) >= 20 and len(random) == len(newton)
     assert max(newton) < 1e-6 and max(random) < 1e-6
+
 
 def test_extrapolated_predictor_saves_a_newton_iteration_per_increment(scene_file, tmp_path, quiet):
     # 5 increments of 1 %: from the accepted state each plastic increment takes 3 Newton iterations (relative
