@@ -90,6 +90,6 @@ def _hint(scene: Scene, reason: str) -> str:
         return ""
     return ("; F-bar (kinematics.volumetric, in a cutting scene cutting.volumetric = \"fbar\") inverts cells "
             "so where many small ones flow plastically: coarser cells there (at a cutting edge cutting.edge_size "
-            "r/2 or more: r/4 and half the step stopped in wendel bench cutting-mesh) or volumetric = \"cell\" (P1 locks: "
-            "stiffer, but it goes on)")
+            "r/2 or more: r/4 and half the step stopped in wendel bench cutting-mesh) or volumetric = \"cell\" "
+            "(P1 locks: stiffer, but it goes on)")
 
