@@ -89,7 +89,6 @@ def test_2d_tangent_is_the_residual_derivative_in_every_direction(tmp_path, quie
     assert max(newton) < 1e-7 and max(random) < 1e-7
 
 
-
 BARREL = """description = "Plane-strain block between sticking platens: barrelling, an inhomogeneous plastic state"
 [geometry]
 builder = "rectangle"
