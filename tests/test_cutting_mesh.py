@@ -94,11 +94,9 @@ def test_bad_zones_are_refused_with_the_key(tmp_path):
     ("cutting-ti", "WENDEL_BENCH_SNAP", "2",
      "WENDEL_BENCH_SNAP = '2': 1 (cutting.snap_to_tool) or 0 (as the scene says)"),
     ("cutting-mesh", "WENDEL_BENCH_FBAR", "yes",
-     "WENDEL_BENCH_FBAR = 'yes': 1 (cutting.volumetric = \"fbar\"), patch (\"fbar-patch\"), 0 (\"cell\") or unset "
-     "(as the scene says)"),
+     "WENDEL_BENCH_FBAR = 'yes': 1 (cutting.volumetric = \"fbar\"), 0 (\"cell\") or unset (as the scene says)"),
     ("cutting-kienzle", "WENDEL_BENCH_FBAR", "2",
-     "WENDEL_BENCH_FBAR = '2': 1 (cutting.volumetric = \"fbar\"), patch (\"fbar-patch\"), 0 (\"cell\") or unset "
-     "(as the scene says)"),
+     "WENDEL_BENCH_FBAR = '2': 1 (cutting.volumetric = \"fbar\"), 0 (\"cell\") or unset (as the scene says)"),
 ])
 def test_the_long_cut_benches_refuse_a_bad_setting_by_name_before_cutting(tmp_path, monkeypatch, name, var, value,
                                                                            words):

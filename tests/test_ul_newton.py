@@ -49,7 +49,7 @@ def fd_differences(root: Path, out: Path) -> tuple[list[float], list[float]]:
     return newton, random
 
 
-@pytest.mark.parametrize("volumetric", ["cell", "fbar", "fbar-patch"])
+@pytest.mark.parametrize("volumetric", ["cell", "fbar"])
 def test_3d_tangent_matches_the_residual_differences_at_a_deformed_plastic_state(scene_file, tmp_path, quiet,
                                                                                  volumetric):
     # 3 increments of 1 % (plastic from the first): the tangent along each Newton direction is the residual's
@@ -123,23 +123,16 @@ png = false
 """
 
 
-@pytest.mark.parametrize("volumetric", ["fbar", "fbar-patch"])
 def test_plane_strain_fbar_tangent_is_the_residual_derivative_on_an_inhomogeneous_plastic_state(scene_file,
-                                                                                               tmp_path, quiet,
-                                                                                               volumetric):
+                                                                                               tmp_path, quiet):
     # The cut's formulation (plane strain, F-bar: the patch term Y' diag(1 / s) Z added to K with the plastic
     # N term of Q, kinematics-fbar.idp) on a barrelling block (4 increments of 5 %): measured 2e-7 along the
     # Newton steps and 3e-8 in random directions (session 19, while tracing the F-bar cut's inversions at the
-    # tool's edge: the tangent is not their cause). Over patches of two cells ("fbar-patch"): 3e-8 at all Newton
-    # iterations but one of 52, where a cell's yield switch falls into the difference (0.13 along the Newton step
-    # and 0.026 in the random direction with a difference step of 1e-6; 2e-7 and 3e-3 at 1e-7, 0.21 and 0.029 at
-    # 1e-5: a kink, not the tangent)
-    text = BARREL.replace('volumetric = "fbar"', f'volumetric = "{volumetric}"')
-    root = run(scene_file(text, "barrel.toml"), out=tmp_path / "run", progress=quiet, png=False)
+    # tool's edge: the tangent is not their cause)
+    root = run(scene_file(BARREL, "barrel.toml"), out=tmp_path / "run", progress=quiet, png=False)
     newton, random = fd_differences(root, tmp_path / "fd")
     assert len(newton) >= 20 and len(random) == len(newton)
-    worst = sorted(max(a, b) for a, b in zip(newton, random))
-    assert worst[-2] < 1e-6 and worst[len(worst) // 2] < 1e-7
+    assert max(newton) < 1e-6 and max(random) < 1e-6
 
 
 def test_extrapolated_predictor_saves_a_newton_iteration_per_increment(scene_file, tmp_path, quiet):

@@ -36,13 +36,6 @@
 //   long wendelFricRowsPQ(matrix M, long n, long nd, int[int] dof0, real[int] fE, real[int] Pb);
 //       M = P Q' (n x n: the identity with the contact nodes' blocks P_j Q_j').
 //
-//   long np = wendelCellPatches(mesh Th, long k, real[int] patch);   (and mesh3 Th)
-//       Splits the cells into patches of k face-adjacent cells (F-bar over fixed patches, lib/kinematics-fbar.idp):
-//       patch resized to Th.nt, patch[e] the patch of cell e (0 .. np - 1). Greedy, in the cells' order: a patch
-//       starts at the first free cell and grows by the free neighbour (of any of its cells) that has the fewest
-//       free neighbours of its own, up to k cells; a patch that stays under (k + 1) / 2 cells joins the smallest
-//       neighbouring patch. Returns np.
-//
 //   long nnz = wendelFbarAdd(matrix K, matrix Y, matrix Z, real[int] sinv, real[int] fr);
 //       F-bar's patch term added to the Newton matrix (lib/kinematics-fbar.idp), in one pass:
 //         K = K + Dfree Y' diag(sinv) Z
@@ -320,81 +313,6 @@ long wendelFbarAdd(Matrice_Creuse<double>* const& K, Matrice_Creuse<double>* con
     }
     fricSetCsr(K, n, rowptr, cols, vals, "wendelFbarAdd");
     return (long)vals.size();
-}
-
-// Patches of k face-adjacent cells (wendelCellPatches). adj(e, j): the cell across face j of e, or -1.
-template<class Adj>
-long cellPatches(long nt, int nea, long k, KN<double>* patch, Adj adj)
-{
-    if (k < 1) ExecError("wendelCellPatches: k must be at least 1");
-    std::vector<int> of(nt, -1), size;
-    auto freeNeighbours = [&](int e) {
-        int c = 0;
-        for (int j = 0; j < nea; ++j) { const int f = adj(e, j); if (f >= 0 && of[f] < 0) ++c; }
-        return c;
-    };
-    std::vector<int> cells;
-    for (long e0 = 0; e0 < nt; ++e0) {
-        if (of[e0] >= 0) continue;
-        const int id = (int)size.size();
-        cells.assign(1, (int)e0);
-        of[e0] = id;
-        while ((long)cells.size() < k) {
-            int best = -1, bestFree = nea + 1;
-            for (int e : cells)
-                for (int j = 0; j < nea; ++j) {
-                    const int f = adj(e, j);
-                    if (f < 0 || of[f] >= 0) continue;
-                    const int c = freeNeighbours(f);
-                    if (c < bestFree) { best = f; bestFree = c; }
-                }
-            if (best < 0) break;
-            of[best] = id;
-            cells.push_back(best);
-        }
-        size.push_back((int)cells.size());
-        if ((long)cells.size() * 2 < k + 1) {
-            int to = -1;
-            for (int e : cells)
-                for (int j = 0; j < nea; ++j) {
-                    const int f = adj(e, j);
-                    if (f >= 0 && of[f] != id && (to < 0 || size[of[f]] < size[to])) to = of[f];
-                }
-            if (to >= 0) {
-                for (int e : cells) of[e] = to;
-                size[to] += (int)cells.size();
-                size[id] = 0;
-            }
-        }
-    }
-    std::vector<int> label(size.size(), -1);
-    long np = 0;
-    patch->resize(nt);
-    for (long e = 0; e < nt; ++e) {
-        if (label[of[e]] < 0) label[of[e]] = (int)np++;
-        (*patch)[e] = label[of[e]];
-    }
-    return np;
-}
-
-long wendelCellPatches2(const Mesh* const& pTh, const long& k, KN<double>* const& patch)
-{
-    const Mesh& Th = *pTh;
-    return cellPatches(Th.nt, 3, k, patch, [&](int e, int j) {
-        int jj = j;
-        const int f = Th.ElementAdj(e, jj);   // a boundary edge links to its own cell
-        return (jj >= 0 && f >= 0 && f != e) ? f : -1;
-    });
-}
-
-long wendelCellPatches3(const Mesh3* const& pTh, const long& k, KN<double>* const& patch)
-{
-    const Mesh3& Th = *pTh;
-    return cellPatches(Th.nt, 4, k, patch, [&](int e, int j) {
-        int jj = j;
-        const int f = Th.ElementAdj(e, jj);
-        return (f >= 0 && f != e) ? f : -1;
-    });
 }
 
 // Shared checks of the contact blocks' arrays (wendelFricVec, wendelFricRowsPQ).
@@ -782,8 +700,6 @@ static void Load_Init()
     Global.Add("wendelFbarAdd", "(",
                new OneOperator5_<long, Matrice_Creuse<double>*, Matrice_Creuse<double>*, Matrice_Creuse<double>*,
                                  KN<double>*, KN<double>*>(wendelFbarAdd));
-    Global.Add("wendelCellPatches", "(", new OneOperator3_<long, pmesh, long, KN<double>*>(wendelCellPatches2));
-    Global.Add("wendelCellPatches", "(", new OneOperator3_<long, pmesh3, long, KN<double>*>(wendelCellPatches3));
     Global.Add("wendelFricRowsPQ", "(",
                new OneOperator6_<long, Matrice_Creuse<double>*, long, long, KN<long>*, KN<double>*,
                                  KN<double>*>(wendelFricRowsPQ));

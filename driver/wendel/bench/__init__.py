@@ -45,21 +45,14 @@ def env_flag(name: str, what: str) -> bool:
 
 
 def volumetric(default: str | None) -> str | None:
-    """The cutting benches' ``cutting.volumetric`` from ``WENDEL_BENCH_FBAR``: 1 F-bar over vertex patches
-    (``"fbar"``), ``patch`` over patches of two cells (``"fbar-patch"``), 0 the P1 cell's own volume change
-    (``"cell"``), unset ``default`` (the scene's: both cutting scenes say ``"cell"``); anything else refused by name."""
+    """The cutting benches' ``cutting.volumetric`` from ``WENDEL_BENCH_FBAR``: 1 F-bar (``"fbar"``), 0 the P1 cell's
+    own volume change (``"cell"``), unset ``default`` (the scene's: both cutting scenes say ``"cell"``); anything else refused by name."""
     v = os.environ.get("WENDEL_BENCH_FBAR")
     if v is None:
         return default
-    if v not in VOLUMETRIC:
-        raise ValueError(f"WENDEL_BENCH_FBAR = {v!r}: 1 (cutting.volumetric = \"fbar\"), patch (\"fbar-patch\"), "
-                         "0 (\"cell\") or unset (as the scene says)")
-    return VOLUMETRIC[v]
-
-
-VOLUMETRIC = {"0": "cell", "1": "fbar", "patch": "fbar-patch"}
-FBAR_TAGS = {"fbar": ", F-bar", "fbar-patch": ", F-bar patch"}
-"""Case-name suffixes of the cutting benches' F-bar runs (folders ``...-F-bar``, ``...-F-bar-patch``)."""
+    if v not in ("0", "1"):
+        raise ValueError(f"WENDEL_BENCH_FBAR = {v!r}: 1 (cutting.volumetric = \"fbar\"), 0 (\"cell\") or unset (as the scene says)")
+    return "fbar" if v == "1" else "cell"
 
 
 def register(name: str):

@@ -139,13 +139,13 @@ def cutting_ti_bench(quick: bool, workdir: Path) -> list[dict]:
     snap = env_flag("WENDEL_BENCH_SNAP", "cutting.snap_to_tool")
     scene.cutting.snap_to_tool = scene.cutting.snap_to_tool or snap
     scene.cutting.volumetric = volumetric(scene.cutting.volumetric)
-    fbar = {"fbar": "-fbar", "fbar-patch": "-fbar-patch"}.get(scene.cutting.volumetric, "")
+    fbar = scene.cutting.volumetric == "fbar"
     if quick:
         scene.cutting.cut_length *= 20 / scene.loading.steps
         scene.loading.steps = 20
     scene.cutting.edge_size = scene.cutting.edge_radius / 2
     workdir.mkdir(parents=True, exist_ok=True)
-    name = ("ti-r2" if mm is None or quick else f"ti-r2-{float(mm) * 1e3:.0f}um") + ("-snap" if snap else "") + fbar
+    name = ("ti-r2" if mm is None or quick else f"ti-r2-{float(mm) * 1e3:.0f}um") + ("-snap" if snap else "") + ("-fbar" if fbar else "")
     row = _case("adiabatic", quick, workdir, scene=scene, scene_path=path, name=name)
     if mm is not None and not quick:
         import csv

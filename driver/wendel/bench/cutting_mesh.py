@@ -32,7 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import FBAR_TAGS, WORKFLOWS, env_flag, register, volumetric
+from . import WORKFLOWS, env_flag, register, volumetric
 
 WINDOW = 160e-6  # m: the compared window, the last 160 um of travel (4 remesh cycles of 40 um without step cuts)
 STEPS = 80       # increments of 5 um: the first 400 um (2.7 h) of the scene's 600 um cut
@@ -162,7 +162,7 @@ def cutting_mesh_bench(quick: bool, workdir: Path) -> list[dict]:
     vol = volumetric(_scene(2, 1, quick).cutting.volumetric)
     rows = []
     for name, divide, substeps in CASES:
-        rows.append(_case(name + FBAR_TAGS.get(vol, ""), divide, substeps, quick, workdir, vol))
+        rows.append(_case(name + (", F-bar" if vol == "fbar" else ""), divide, substeps, quick, workdir, vol))
         (workdir / "partial.json").write_text(json.dumps(rows, indent=1))     # a long bench that stops keeps its cases
     by = {(r["edge_size_um"], r["step_um"]): r for r in rows}
     finest = min(r["edge_size_um"] for r in rows)

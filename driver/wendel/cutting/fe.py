@@ -138,7 +138,7 @@ def fe_scene(scene, travel: float = 1.0) -> Scene:
     # instead of 92.5, measured: "mesh would invert" after the second remesh)
     remesh = {"at": at, "indicator": "", "h": fine * g.h * MM, "max_remeshes": len(at) + 20,
               "relax_steps": RELAX_STEPS}
-    smooth = c.smooth_features if c.smooth_features is not None else (SMOOTH_FBAR if c.volumetric != "cell" else 0.0)
+    smooth = c.smooth_features if c.smooth_features is not None else (SMOOTH_FBAR if c.volumetric == "fbar" else 0.0)
     if smooth > 0:
         remesh["smooth_features"] = smooth
     if c.snap_to_tool:

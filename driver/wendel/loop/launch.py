@@ -86,7 +86,7 @@ def options(scene: Scene, files: RunFiles, dimension: int, segment: dict | None 
             opts += [f"-{key}", str(files.root / segment[key])]
     if (files.tables / "motion.txt").is_file():
         opts += ["-bc_motion", str(files.tables / "motion.txt")]
-    opts += kinematics_options(scene, dimension)
+    opts += kinematics_options(scene)
     bf = scene.body_force
     v = list(bf.value) + [0.0] * (3 - len(bf.value))
     opts += ["-body_id", str(BODY_FORCES[bf.kind]), "-body_fx", repr(v[0]), "-body_fy", repr(v[1]),
@@ -100,21 +100,14 @@ def options(scene: Scene, files: RunFiles, dimension: int, segment: dict | None 
     return opts
 
 
-FBAR_PATCH_CELLS = {2: 2, 3: 6}
-"""Cells per patch of ``volumetric = "fbar-patch"`` by dimension: about one constraint per vertex, as the vertex
-patches (a triangle mesh has about 2 cells per vertex, a tetrahedral one 5-6)."""
-
-
-def kinematics_options(scene: Scene, dimension: int) -> list[str]:
+def kinematics_options(scene: Scene) -> list[str]:
     """Updated-Lagrangian kinematics (edp/lib/kinematics.idp, compiled by the -D switch of :func:`macros`)."""
     k = scene.kinematics
     if not k.updated_lagrangian:
         return []
     e = k.initial_strain
-    import os      # WENDEL_FBAR_PATCH: another patch size, for measurement (README, session 20)
-    patch = int(os.environ.get("WENDEL_FBAR_PATCH", FBAR_PATCH_CELLS[dimension])) if k.volumetric == "fbar-patch" else 0
-    return ["-ul_min_jacobian", repr(k.min_area_ratio), "-ul_volumetric", str(int(k.volumetric != "cell")),
-            "-ul_fbar_patch", str(patch), "-ul_eps_xx", repr(e[0]), "-ul_eps_yy", repr(e[1]), "-ul_eps_xy", repr(e[2])]
+    return ["-ul_min_jacobian", repr(k.min_area_ratio), "-ul_volumetric", str(int(k.volumetric == "fbar")),
+            "-ul_eps_xx", repr(e[0]), "-ul_eps_yy", repr(e[1]), "-ul_eps_xy", repr(e[2])]
 
 
 def write_tables(scene: Scene, files: RunFiles, dimension: int) -> None:

@@ -86,7 +86,7 @@ def _hint(scene: Scene, reason: str) -> str:
     """What a user can change when F-bar tangles the mesh (measured on the FE cut, README "F-bar on fine edge
     meshes, traced"): its vertex patches leave the small cells of a fully plastic zone to the plastic tangent
     alone, and the finer the mesh there, the sooner a Newton step turns one inside out."""
-    if reason != "mesh would invert" or scene.kinematics.volumetric == "cell":
+    if reason != "mesh would invert" or scene.kinematics.volumetric != "fbar":
         return ""
     return ("; F-bar (kinematics.volumetric, in a cutting scene cutting.volumetric = \"fbar\") inverts cells "
             "so where many small ones flow plastically: coarser cells there (at a cutting edge cutting.edge_size "

@@ -231,13 +231,11 @@ class Kinematics(Strict):
                                   "a cell's area below this ratio is refused as tangling (the step is cut) [1]")
     initial_strain: list[float] = Field([0.0, 0.0, 0.0], description="updated-Lagrangian: homogeneous initial "
                                         "strain [xx, yy, xy] (tensor components) of a prestressed body [1]")
-    volumetric: Literal["cell", "fbar", "fbar-patch"] = Field("cell", description="updated-Lagrangian: the "
-                                                              "volume change of a P1 cell is its own (\"cell\"), "
-                                                              "or F-bar: the increment's volume change averaged "
-                                                              "over the vertex patches (\"fbar\") or over fixed "
-                                                              "patches of face-adjacent cells (\"fbar-patch\": 2 "
-                                                              "triangles, 6 tetrahedra); against volumetric locking "
-                                                              "in plastic flow, edp/lib/kinematics-fbar.idp")
+    volumetric: Literal["cell", "fbar"] = Field("cell", description="updated-Lagrangian: the "
+                                                "volume change of a P1 cell is its own (\"cell\"), or F-bar: the "
+                                                "increment's volume change averaged over the vertex patches "
+                                                "(\"fbar\"; against volumetric locking in plastic flow, "
+                                                "edp/lib/kinematics-fbar.idp)")
 
     @field_validator("initial_strain")
     @classmethod

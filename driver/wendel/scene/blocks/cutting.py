@@ -95,10 +95,9 @@ class Cutting(BaseModel):
                                              "k and c (and rho c of the adiabatic heating) are taken from thermal.k, "
                                              "thermal.c and k_slope, c_slope (the FE's k and c are constant) [K]; "
                                              "default: thermal.k and thermal.c as written (at properties_T0)")
-    volumetric: Literal["cell", "fbar", "fbar-patch"] = Field("cell", description="FE: the updated-Lagrangian "
-                                                              "volume change, per cell (P1, locks in the isochoric "
-                                                              "plastic flow) or F-bar over vertex patches or cell "
-                                                              "patches (kinematics.volumetric)")
+    volumetric: Literal["cell", "fbar"] = Field("cell", description="FE: the updated-Lagrangian volume change, "
+                                                "per cell (P1, locks in the isochoric plastic flow) or F-bar "
+                                                "(kinematics.volumetric)")
     smooth_features: Optional[float] = Field(None, ge=0, lt=0.5, description="FE: the remeshes drop old boundary "
                                              "nodes of features below the new mesh's size, as remesh.smooth_features "
                                              "[1]; default 0.25 with volumetric = fbar (its chip front folds into "
