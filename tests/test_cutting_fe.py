@@ -133,7 +133,8 @@ def test_fe_cut_fbar_compiled_patch_term_is_the_freefem_one(tmp_path):
 @pytest.mark.parametrize("volumetric", ["fbar", "cell"])
 def test_an_fbar_cut_that_tangles_stops_with_what_to_change(tmp_path, volumetric):
     # The last step cut of a failing increment stops the run; when F-bar tangled the mesh the message says which
-    # keys go on (README "F-bar on fine edge meshes, traced"); with the cells' own volume change it does not.
+    # keys go on (README "What inverts the fine F-bar meshes"): the steel scene is heated adiabatically, so
+    # conduction first; with the cells' own volume change it says nothing more.
     from wendel import freefem
     from wendel.errors import StepCutError
     from wendel.loop.checkpoint import RunFiles, State
@@ -149,3 +150,4 @@ def test_an_fbar_cut_that_tangles_stops_with_what_to_change(tmp_path, volumetric
     text = str(err.value)
     assert "mesh would invert, even after" in text and "1 accepted increments are kept" in text
     assert ("cutting.edge_size" in text and 'volumetric = "cell"' in text) == (volumetric == "fbar")
+    assert ('thermal.coupling = "staggered"' in text) == (volumetric == "fbar")

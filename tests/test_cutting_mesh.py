@@ -95,6 +95,9 @@ def test_bad_zones_are_refused_with_the_key(tmp_path):
      "WENDEL_BENCH_SNAP = '2': 1 (cutting.snap_to_tool) or 0 (as the scene says)"),
     ("cutting-mesh", "WENDEL_BENCH_FBAR", "yes",
      "WENDEL_BENCH_FBAR = 'yes': 1 (cutting.volumetric = \"fbar\"), 0 (\"cell\") or unset (as the scene says)"),
+    ("cutting-mesh", "WENDEL_BENCH_HEAT", "adiabatic",
+     "WENDEL_BENCH_HEAT = 'adiabatic': isothermal (no Taylor-Quinney heat, thermal.beta = 0), conduction "
+     "(thermal.coupling = \"staggered\") or unset (the scene's adiabatic heating)"),
     ("cutting-kienzle", "WENDEL_BENCH_FBAR", "2",
      "WENDEL_BENCH_FBAR = '2': 1 (cutting.volumetric = \"fbar\"), 0 (\"cell\") or unset (as the scene says)"),
 ])

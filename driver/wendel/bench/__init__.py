@@ -55,6 +55,27 @@ def volumetric(default: str | None) -> str | None:
     return "fbar" if v == "1" else "cell"
 
 
+HEAT = {"isothermal": "no Taylor-Quinney heat, thermal.beta = 0", "conduction": 'thermal.coupling = "staggered"'}
+"""``WENDEL_BENCH_HEAT`` of ``cutting-mesh`` and ``cutting-fbar`` (:func:`heat`): the heat of every case (unset:
+the scene's adiabatic heating). Session 20: the adiabatic Johnson-Cook steel softens with its own heat, and on fine F-bar meshes
+that flow localizes and inverts cells; without the heat, or with conduction, it does not (README)."""
+
+
+def heat(scene) -> str:
+    """Apply ``WENDEL_BENCH_HEAT`` to ``scene``; the case-name suffix (refused by name when unknown)."""
+    v = os.environ.get("WENDEL_BENCH_HEAT")
+    if v is None:
+        return ""
+    if v not in HEAT:
+        raise ValueError(f"WENDEL_BENCH_HEAT = {v!r}: " + ", ".join(f"{k} ({w})" for k, w in HEAT.items())
+                         + " or unset (the scene's adiabatic heating)")
+    if v == "isothermal":
+        scene.thermal.beta = 0.0
+    else:
+        scene.thermal.coupling = "staggered"
+    return ", " + v
+
+
 def register(name: str):
     """Register a benchmark ``func(quick, workdir) -> rows`` under ``name``."""
 

@@ -20,8 +20,7 @@ the same case without it; ``wendel bench cutting-steady-fbar``: ``cutting-steady
 
 Each case is written to ``results/bench/work/cutting-mesh/<case>/``; a case whose folder already holds the
 finished cut of the same scene (``cutting.csv`` and ``summary.json`` of that ``scene.resolved.json``) is read,
-not run again (the cases take 8-25 minutes each here): delete the folder to run it again.
-"""
+not run again (the cases take 8-25 minutes each here): delete the folder to run it again."""
 
 from __future__ import annotations
 
@@ -32,7 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import WORKFLOWS, env_flag, register, volumetric
+from . import WORKFLOWS, env_flag, heat, register, volumetric
 
 WINDOW = 160e-6  # m: the compared window, the last 160 um of travel (4 remesh cycles of 40 um without step cuts)
 STEPS = 80       # increments of 5 um: the first 400 um (2.7 h) of the scene's 600 um cut
@@ -125,6 +124,7 @@ def _case(name: str, divide: int, substeps: int, quick: bool, workdir: Path, vol
     from ..freefem import FreeFemError, NewtonFailure
 
     scene = _scene(divide, substeps, quick, vol)
+    name += heat(scene)         # WENDEL_BENCH_HEAT
     out = workdir / name.replace("/", "").replace(", ", "-").replace(" ", "-")
     stopped, wall = "", float("nan")
     if _finished(out, scene):
@@ -155,8 +155,8 @@ def _case(name: str, divide: int, substeps: int, quick: bool, workdir: Path, vol
 
 @register("cutting-mesh")
 def cutting_mesh_bench(quick: bool, workdir: Path) -> list[dict]:
-    """Three edge resolutions and two steps of the steel cut (see the module; 50-60 minutes, quick 10);
-    ``WENDEL_BENCH_FBAR=1``: every case with F-bar (case folders ``...-F-bar``)."""
+    """Three edge resolutions and two steps of the steel cut (see the module; 50-60 minutes, quick 10); every case
+    with F-bar: ``WENDEL_BENCH_FBAR=1`` (folders ``...-F-bar``), heated otherwise: ``WENDEL_BENCH_HEAT`` (:func:`heat`)."""
     from ..cutting.scene import predict
     workdir.mkdir(parents=True, exist_ok=True)
     vol = volumetric(_scene(2, 1, quick).cutting.volumetric)

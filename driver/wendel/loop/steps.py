@@ -83,13 +83,20 @@ def cut_step(scene: Scene, files: RunFiles, state: State, failure: freefem.Newto
 
 
 def _hint(scene: Scene, reason: str) -> str:
-    """What a user can change when F-bar tangles the mesh (measured on the FE cut, README "F-bar on fine edge
-    meshes, traced"): its vertex patches leave the small cells of a fully plastic zone to the plastic tangent
-    alone, and the finer the mesh there, the sooner a Newton step turns one inside out."""
+    """What a user can change when F-bar tangles the mesh (measured on the FE cut, README "What inverts the fine
+    F-bar meshes: adiabatic softening"): heated adiabatically, the Johnson-Cook flow softens with its own heat and
+    localizes into the small cells at the edge; the same cuts without that heat, or with conduction, run through."""
     if reason != "mesh would invert" or scene.kinematics.volumetric != "fbar":
         return ""
-    return ("; F-bar (kinematics.volumetric, in a cutting scene cutting.volumetric = \"fbar\") inverts cells "
-            "so where many small ones flow plastically: coarser cells there (at a cutting edge cutting.edge_size "
-            "r/2 or more: r/4 and half the step stopped in wendel bench cutting-mesh) or volumetric = \"cell\" "
-            "(P1 locks: stiffer, but it goes on)")
+    th = getattr(scene, "thermal", None)
+    text = ("; F-bar (kinematics.volumetric, in a cutting scene cutting.volumetric = \"fbar\") inverts cells "
+            "where many small ones flow plastically")
+    if th is not None and th.coupling == "adiabatic" and th.beta > 0:
+        text += (": heated adiabatically (thermal.coupling = \"adiabatic\"), the flow softens with its own heat "
+                 "and localizes there; with heat conduction (thermal.coupling = \"staggered\") the r/4 edge mesh "
+                 "cut through in wendel bench cutting-mesh. Or")
+    else:
+        text += ":"
+    return text + (" coarser cells there (at a cutting edge cutting.edge_size r/2 or more) or volumetric = "
+                   "\"cell\" (P1 locks: stiffer, but it goes on)")
 
