@@ -98,6 +98,15 @@ def test_bad_zones_are_refused_with_the_key(tmp_path):
     ("cutting-mesh", "WENDEL_BENCH_HEAT", "adiabatic",
      "WENDEL_BENCH_HEAT = 'adiabatic': isothermal (no Taylor-Quinney heat, thermal.beta = 0), conduction "
      "(thermal.coupling = \"staggered\") or unset (the scene's adiabatic heating)"),
+    ("cutting-mesh", "WENDEL_BENCH_EDGES", "3,4",
+     "WENDEL_BENCH_EDGES = '3,4': three different whole numbers from 2 to 8, the edge radius over the edge size "
+     "(e.g. 3,4,5), and optionally one of them again, cut at half the step"),
+    ("cutting-mesh", "WENDEL_BENCH_EDGES", "3,4,4",
+     "WENDEL_BENCH_EDGES = '3,4,4': three different whole numbers from 2 to 8, the edge radius over the edge size "
+     "(e.g. 3,4,5), and optionally one of them again, cut at half the step"),
+    ("cutting-mesh", "WENDEL_BENCH_EDGES", "3,4,5,2",
+     "WENDEL_BENCH_EDGES = '3,4,5,2': three different whole numbers from 2 to 8, the edge radius over the edge size "
+     "(e.g. 3,4,5), and optionally one of them again, cut at half the step"),
     ("cutting-kienzle", "WENDEL_BENCH_FBAR", "2",
      "WENDEL_BENCH_FBAR = '2': 1 (cutting.volumetric = \"fbar\"), 0 (\"cell\") or unset (as the scene says)"),
 ])
@@ -110,3 +119,13 @@ def test_the_long_cut_benches_refuse_a_bad_setting_by_name_before_cutting(tmp_pa
         BENCHES[name](False, tmp_path)
     assert str(err.value) == words
     assert not any(tmp_path.iterdir())          # nothing cut
+
+
+def test_the_mesh_bench_takes_its_three_edges_from_the_environment(monkeypatch):
+    from wendel.bench import edges
+    from wendel.bench.cutting_mesh import CASES
+    assert edges(CASES) == CASES
+    monkeypatch.setenv("WENDEL_BENCH_EDGES", "5,3,4")
+    assert edges(CASES) == [("r/3", 3, 1), ("r/5", 5, 1), ("r/4", 4, 1), ("r/3, half step", 3, 2)]
+    monkeypatch.setenv("WENDEL_BENCH_EDGES", "3,4,5,4")
+    assert edges(CASES)[3] == ("r/4, half step", 4, 2)

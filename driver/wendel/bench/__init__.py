@@ -76,6 +76,27 @@ def heat(scene) -> str:
     return ", " + v
 
 
+def edges(default: list[tuple[str, int, int]]) -> list[tuple[str, int, int]]:
+    """``cutting-mesh``'s cases from ``WENDEL_BENCH_EDGES``: three whole numbers, the edge radius over the edge size
+    (e.g. ``3,4,5``), cut at the scene's step, and optionally a fourth, the one of them cut at half the step (by
+    default the coarsest); unset ``default`` (r/2, r/3, r/4, r/2 at half the step). Session 21: with conduction,
+    F-bar's r/2 cut and r/2 and r/3 at half the step stop where r/3 to r/5 and r/4 at half the step run through."""
+    v = os.environ.get("WENDEL_BENCH_EDGES")
+    if v is None:
+        return default
+    words = v.split(",")
+    try:
+        d = [int(x) for x in words]
+    except ValueError:
+        d = []
+    if len(d) not in (3, 4) or len(set(d[:3])) != 3 or not all(2 <= x <= 8 for x in d) or d[3:] and d[3] not in d[:3]:
+        raise ValueError(f"WENDEL_BENCH_EDGES = {v!r}: three different whole numbers from 2 to 8, the edge radius "
+                         "over the edge size (e.g. 3,4,5), and optionally one of them again, cut at half the step")
+    half = d[3] if len(d) == 4 else min(d[:3])
+    a, b, c = sorted(d[:3])
+    return [(f"r/{a}", a, 1), (f"r/{c}", c, 1), (f"r/{b}", b, 1), (f"r/{half}, half step", half, 2)]
+
+
 def register(name: str):
     """Register a benchmark ``func(quick, workdir) -> rows`` under ``name``."""
 

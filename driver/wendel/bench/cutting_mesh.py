@@ -31,7 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import WORKFLOWS, env_flag, heat, register, volumetric
+from . import WORKFLOWS, edges, env_flag, heat, register, volumetric
 
 WINDOW = 160e-6  # m: the compared window, the last 160 um of travel (4 remesh cycles of 40 um without step cuts)
 STEPS = 80       # increments of 5 um: the first 400 um (2.7 h) of the scene's 600 um cut
@@ -155,13 +155,13 @@ def _case(name: str, divide: int, substeps: int, quick: bool, workdir: Path, vol
 
 @register("cutting-mesh")
 def cutting_mesh_bench(quick: bool, workdir: Path) -> list[dict]:
-    """Three edge resolutions and two steps of the steel cut (see the module; 50-60 minutes, quick 10); every case
-    with F-bar: ``WENDEL_BENCH_FBAR=1`` (folders ``...-F-bar``), heated otherwise: ``WENDEL_BENCH_HEAT`` (:func:`heat`)."""
+    """Three edge resolutions and two steps of the steel cut (see the module; 50-60 minutes, quick 10); F-bar:
+    ``WENDEL_BENCH_FBAR=1`` (folders ``...-F-bar``), heat: ``WENDEL_BENCH_HEAT``, edges: ``WENDEL_BENCH_EDGES``."""
     from ..cutting.scene import predict
     workdir.mkdir(parents=True, exist_ok=True)
     vol = volumetric(_scene(2, 1, quick).cutting.volumetric)
     rows = []
-    for name, divide, substeps in CASES:
+    for name, divide, substeps in edges(CASES):
         rows.append(_case(name + (", F-bar" if vol == "fbar" else ""), divide, substeps, quick, workdir, vol))
         (workdir / "partial.json").write_text(json.dumps(rows, indent=1))     # a long bench that stops keeps its cases
     by = {(r["edge_size_um"], r["step_um"]): r for r in rows}
