@@ -130,18 +130,27 @@ def test_fe_cut_fbar_compiled_patch_term_is_the_freefem_one(tmp_path):
         assert len(a) == len(b) >= 2 and max(abs(x - y) for x, y in zip(a, b)) < 1e-9 * max(a), (inc, a, b)
 
 
-@pytest.mark.parametrize("volumetric", ["fbar", "cell"])
-def test_an_fbar_cut_that_tangles_stops_with_what_to_change(tmp_path, volumetric):
+@pytest.mark.parametrize("volumetric, heat, words", [
+    ("fbar", "adiabatic", ['thermal.coupling = "staggered"', "r/3 to r/5", 'volumetric = "cell"']),
+    ("fbar", "staggered", ["cutting.edge_size r/3 or less", 'volumetric = "cell"']),
+    ("fbar", "none", ["cutting.edge_size r/2 or more", 'volumetric = "cell"']),
+    ("cell", "adiabatic", [])])
+def test_an_fbar_cut_that_tangles_stops_with_what_to_change(tmp_path, volumetric, heat, words):
     # The last step cut of a failing increment stops the run; when F-bar tangled the mesh the message says which
-    # keys go on (README "What inverts the fine F-bar meshes"): the steel scene is heated adiabatically, so
-    # conduction first; with the cells' own volume change it says nothing more.
+    # keys go on (README "What inverts the fine F-bar meshes"): heated adiabatically, conduction first; with
+    # conduction finer edge cells; without heat coarser ones; with the cells' own volume change nothing more.
     from wendel import freefem
     from wendel.errors import StepCutError
     from wendel.loop.checkpoint import RunFiles, State
     from wendel.loop.steps import cut_step
     scene = load(STEEL, smoke=True)
     scene.cutting.volumetric = volumetric
+    if heat == "none":
+        scene.thermal.beta = 0.0
+    else:
+        scene.thermal.coupling = heat
     scene = fe_scene(scene)
+    scene.remesh.on_failure = False     # stop here (remeshed and tried again: tests/test_remesh_failure.py)
     lf = 0.5 + scene.loading.nominal_step() / 2 ** (scene.loading.max_cuts + 1)      # no halving left
     state = State(accepted=[(7, 0.5)], pending=[lf])
     failure = freefem.NewtonFailure({"increment": 8, "load_factor": lf, "reason": "mesh would invert"})
@@ -149,5 +158,5 @@ def test_an_fbar_cut_that_tangles_stops_with_what_to_change(tmp_path, volumetric
         cut_step(scene, RunFiles(tmp_path), state, failure, lambda *_: None)
     text = str(err.value)
     assert "mesh would invert, even after" in text and "1 accepted increments are kept" in text
-    assert ("cutting.edge_size" in text and 'volumetric = "cell"' in text) == (volumetric == "fbar")
-    assert ('thermal.coupling = "staggered"' in text) == (volumetric == "fbar")
+    assert all(w in text for w in words), text
+    assert ("F-bar (kinematics.volumetric" in text) == (volumetric == "fbar")

@@ -227,7 +227,7 @@ def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress)
             raise freefem.FreeFemError(f"FreeFEM ended without committing increment {state.last[0] + 1} whole "
                                        f"(see {files.fem / f'inc-{state.last[0] + 1:04d}'})")
         if failure is not None:
-            cut_step(scene, files, state, failure, progress)
+            cut_step(scene, files, state, failure, progress, dimension)
             _save_checkpoint(files, scene, state, dimension)
             continue
         if scene.loading.adaptive and not was_reequilibration:

@@ -34,8 +34,10 @@ def grow_step(scene: Scene, state: State, files: RunFiles) -> None:
 RELAX_MAX = 64      # most stages of a re-equilibration (remesh.relax_steps doubled on failure)
 
 
-def cut_step(scene: Scene, files: RunFiles, state: State, failure: freefem.NewtonFailure, progress) -> None:
-    """Halve the failed increment, or stop with a clear message when no cut is left."""
+def cut_step(scene: Scene, files: RunFiles, state: State, failure: freefem.NewtonFailure, progress,
+             dimension: int = 2) -> None:
+    """Halve the failed increment; when no cut is left, remesh and go on (``remesh.on_failure``, :func:`_remesh`)
+    or stop with a clear message."""
     rec = failure.record
     inc = state.last[0] + 1
     failed = files.fem / f"inc-{inc:04d}"
@@ -60,12 +62,21 @@ def cut_step(scene: Scene, files: RunFiles, state: State, failure: freefem.Newto
         if remesh_again(scene, files, state, progress):      # another mesh of the same body
             state.cuts += 1
             return
+        if _keep_old_mesh(scene, files, state, progress, inc):
+            state.cuts += 1
+            return
     state.cuts += 1
     mid = lf_prev + 0.5 * (lf_fail - lf_prev)
     smallest = scene.loading.nominal_step() / 2 ** scene.loading.max_cuts
     if reason == "limit load reached" or abs(mid - lf_prev) < smallest * (1 - 1e-9):
+        if reason != "limit load reached" and _remesh(scene, files, state, dimension, progress, inc, reason):
+            return
         what = "limit load reached" if reason == "limit load reached" else \
             f"{reason}, even after {scene.loading.max_cuts} step halvings (loading.max_cuts)"
+        if state.reequilibrate and state.remeshes and lf_fail == lf_prev:
+            rep = state.remeshes[-1]
+            what = (f"{reason} in the re-equilibration after remesh {rep.get('remesh')}, even in "
+                    f"{rep.get('relax_steps')} stages on {rep.get('algorithm_2d_tries', 0) + 1} meshes of the body")
         # the bracket of the limit (or of the failure): summary.json reports it
         (files.root / "stopped.json").write_text(json.dumps(
             {"increment": inc, "reason": what, "last_converged_load_factor": lf_prev,
@@ -82,21 +93,67 @@ def cut_step(scene: Scene, files: RunFiles, state: State, failure: freefem.Newto
     progress(f"  increment {inc}: {reason} at load factor {lf_fail:g}; cutting the step to {mid:g}")
 
 
+def _keep_old_mesh(scene: Scene, files: RunFiles, state: State, progress, inc: int) -> bool:
+    """The re-equilibration after a remesh failed on every mesh: when the old mesh can go on (no cell inverted,
+    its min SICN at least half of ``remesh.min_quality``; the remesh was not made because a step failed), drop the
+    remesh and go on with the old mesh, remeshed again when its quality or the schedule next says. Measured on
+    the FE cut (README, session 21): the F-bar cuts with conduction that stopped so had remeshed on schedule at a
+    min SICN of 0.11-0.24."""
+    rep = state.remeshes[-1]
+    if rep.get("after_failed_step") or rep.get("inverted_before", 1) > 0 \
+            or rep.get("min_quality_before", 0.0) < 0.5 * scene.remesh.min_quality:
+        return False
+    state.remeshes.pop()
+    state.segments.pop()
+    state.pending.pop(0)
+    state.reequilibrate = False
+    keep = files.root / "failed-attempts"
+    keep.mkdir(exist_ok=True)
+    (keep / f"remesh-{rep.get('remesh')}-after-{rep.get('after_increment')}.json").write_text(json.dumps(rep, indent=1))
+    progress(f"  increment {inc}: the re-equilibration after remesh {rep.get('remesh')} failed on every mesh; "
+             f"going on with the mesh before it (min quality {rep.get('min_quality_before', float('nan')):.3g})")
+    return True
+
+
+def _remesh(scene: Scene, files: RunFiles, state: State, dimension: int, progress, inc: int, reason: str) -> bool:
+    """A forward step that failed even in its smallest cut: remesh the last converged increment and go on from
+    it with the nominal steps (``remesh.on_failure``; once per mesh: not when that increment is the first on
+    its mesh). Measured on the FE cut (README, session 21): the cells under the edge lose quality over the
+    increments (min SICN 0.39 -> 0.11 in ten) and the step fails just before the 0.1 of ``remesh.min_quality``."""
+    r = scene.remesh
+    last = state.last[0]
+    if not (r and r.on_failure and state.accepted and not state.reequilibrate
+            and last > state.segments[-1]["first"] and len(state.remeshes) < r.max_remeshes):
+        return False
+    from ..remesh.step import maybe_remesh
+    targets = scene.loading.load_factors()
+    state.pending = [p for p in state.pending if any(abs(p - t) <= 1e-12 * max(1.0, abs(t)) for t in targets)]
+    if scene.loading.adaptive:
+        state.step = scene.loading.nominal_step()
+    progress(f"  increment {inc}: {reason}, even after {scene.loading.max_cuts} step halvings: remeshing "
+             f"increment {last} and going on (remesh.on_failure)")
+    maybe_remesh(scene, files, state, dimension, progress, failed=True)
+    return True
+
+
 def _hint(scene: Scene, reason: str) -> str:
     """What a user can change when F-bar tangles the mesh (measured on the FE cut, README "What inverts the fine
     F-bar meshes: adiabatic softening"): heated adiabatically, the Johnson-Cook flow softens with its own heat and
-    localizes into the small cells at the edge; the same cuts without that heat, or with conduction, run through."""
+    localizes into the small cells at the edge, and the same cuts with conduction run through on edge meshes of
+    r/3 to r/5, where r/2 stopped; without heat every edge mesh from r/2 to r/4 ran through."""
     if reason != "mesh would invert" or scene.kinematics.volumetric != "fbar":
         return ""
     th = getattr(scene, "thermal", None)
     text = ("; F-bar (kinematics.volumetric, in a cutting scene cutting.volumetric = \"fbar\") inverts cells "
             "where many small ones flow plastically")
-    if th is not None and th.coupling == "adiabatic" and th.beta > 0:
-        text += (": heated adiabatically (thermal.coupling = \"adiabatic\"), the flow softens with its own heat "
-                 "and localizes there; with heat conduction (thermal.coupling = \"staggered\") the r/4 edge mesh "
-                 "cut through in wendel bench cutting-mesh. Or")
-    else:
-        text += ":"
-    return text + (" coarser cells there (at a cutting edge cutting.edge_size r/2 or more) or volumetric = "
+    if th is not None and th.beta > 0 and th.coupling == "adiabatic":
+        return text + (": heated adiabatically (thermal.coupling = \"adiabatic\"), the flow softens with its own "
+                       "heat and localizes there; with heat conduction (thermal.coupling = \"staggered\") the edge "
+                       "meshes r/3 to r/5 cut through in wendel bench cutting-mesh. Or volumetric = \"cell\" (P1 "
+                       "locks: stiffer, but it goes on)")
+    if th is not None and th.beta > 0:
+        return text + (": with conduction the cut at an edge size of r/2 stopped where r/3 to r/5 ran through "
+                       "(wendel bench cutting-mesh): finer cells at the edge (cutting.edge_size r/3 or less), or "
+                       "volumetric = \"cell\" (P1 locks: stiffer, but it goes on)")
+    return text + (": coarser cells there (at a cutting edge cutting.edge_size r/2 or more) or volumetric = "
                    "\"cell\" (P1 locks: stiffer, but it goes on)")
-

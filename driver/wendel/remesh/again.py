@@ -26,7 +26,7 @@ def remesh_again(scene, files, state, progress) -> bool:
     progress(f"  increment {rep['after_increment']}: the re-equilibration failed; meshing again with gmsh algorithm "
              f"{AGAIN[tried]}")
     from .step import maybe_remesh
-    maybe_remesh(scene, files, state, 2, progress, again=tried + 1)
+    maybe_remesh(scene, files, state, 2, progress, again=tried + 1, failed=rep.get("after_failed_step", False))
     return True
 
 

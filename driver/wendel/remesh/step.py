@@ -255,9 +255,10 @@ def finish_report(report: dict, reeq_dir: Path, path: Path) -> dict:
     return report
 
 
-def maybe_remesh(scene, files, state, dimension: int, progress, again: int = 0) -> None:
+def maybe_remesh(scene, files, state, dimension: int, progress, again: int = 0, failed: bool = False) -> None:
     """The loop's remesh step: after the last accepted increment, remesh when its deformed mesh is too poor
-    (or the scene asks); the next launch re-equilibrates the transferred state at the same load factor.
+    (or the scene asks, or the next step ``failed`` even in its smallest cut); the next launch re-equilibrates
+    the transferred state at the same load factor.
 
     ``files`` and ``state`` are the loop's :class:`wendel.loop.checkpoint.RunFiles` and ``State``.
     """
@@ -267,7 +268,7 @@ def maybe_remesh(scene, files, state, dimension: int, progress, again: int = 0) 
         return      # already remeshed after this increment (a resumed run)
     q = state.quality.get(inc, {})
     poor = q.get("min_quality", 1.0) < r.min_quality or q.get("inverted", 0) > 0
-    if not (poor or inc in r.at):
+    if not (poor or failed or inc in r.at):
         return
     if len(state.remeshes) >= r.max_remeshes:
         if poor:
@@ -280,8 +281,8 @@ def maybe_remesh(scene, files, state, dimension: int, progress, again: int = 0) 
     mesh_new = f"meshes/mesh-{k}.msh"
     state_dir = f"remesh/state-{k}"
     ubase_old = vtu.read_array(files.root / seg["ubase"]) if seg["ubase"] else None
-    progress(f"  increment {inc}: min quality {q.get('min_quality', float('nan')):.3g}"
-             f"{' (asked by remesh.at)' if not poor else ''}: remeshing")
+    why = " (the next step failed)" if failed else " (asked by remesh.at)" if not poor else ""
+    progress(f"  increment {inc}: min quality {q.get('min_quality', float('nan')):.3g}{why}: remeshing")
     rep = made_or_failed(lambda: remesh_state(
         files.fem / f"inc-{inc:04d}", files.root / seg["mesh"], ubase_old, dimension, files.root / mesh_new,
         files.root / state_dir, h, r.h_min or h / 3, r.indicator, mu=scene.material.E / (2 * (1 + scene.material.nu)),
@@ -289,7 +290,7 @@ def maybe_remesh(scene, files, state, dimension: int, progress, again: int = 0) 
         algorithm_2d=AGAIN[again - 1] if again else None, smooth_features=r.smooth_features,
         tool=tool_at(scene, files.fem / f"inc-{inc:04d}") if r.snap_to_tool else None), k, inc, lf, q, files.root)
     rep.update({"remesh": k, "after_increment": inc, "load_factor": lf, "dimension": dimension,
-                "algorithm_2d_tries": again})
+                "algorithm_2d_tries": again, "after_failed_step": failed})
     state.remeshes.append(rep)
     state.segments.append({"first": inc + 1, "mesh": mesh_new, "ubase": f"{state_dir}/ubase.txt",
                            "eps0": f"{state_dir}/eps0.txt", "state": state_dir})

@@ -1,0 +1,107 @@
+"""What the loop does when a step or a re-equilibration fails for good on a remeshed run (``wendel.loop.steps``).
+
+A re-equilibration after a scheduled remesh that fails in the most stages on every gmsh mesh drops the remesh and
+goes on with the old mesh (when no cell of it is inverted); a forward step that fails even in its smallest cut is
+remeshed once and tried again (``remesh.on_failure``); what cannot go on stops with a message that says what
+failed and keeps the accepted increments. The decisions are made on the loop's state, without FreeFEM (the remesh
+of a forward failure is a real one in ``test_a_step_that_fails_for_good_is_remeshed_once``)."""
+
+import csv
+import json
+
+import pytest
+
+from wendel import freefem
+from wendel.cutting.fe import fe_scene
+from wendel.errors import StepCutError
+from wendel.loop.checkpoint import RunFiles, State
+from wendel.loop.steps import RELAX_MAX, cut_step
+from wendel.remesh.again import AGAIN
+from wendel.scene import load
+
+from conftest import WORKFLOWS
+
+
+def _reequilibrating(after_failed_step: bool, inverted: int, quality: float = 0.11):
+    scene = fe_scene(load(WORKFLOWS / "cutting-aisi1045.toml", smoke=True))
+    rep = {"remesh": 2, "after_increment": 9, "relax_steps": RELAX_MAX, "algorithm_2d_tries": len(AGAIN),
+           "dimension": 2, "min_quality_before": quality, "inverted_before": inverted,
+           "after_failed_step": after_failed_step}
+    state = State(accepted=[(9, 0.5)], pending=[0.5, 0.55, 0.6], remeshes=[rep], reequilibrate=True)
+    state.segments.append({"first": 10, "mesh": "meshes/mesh-2.msh", "ubase": None, "eps0": None,
+                           "state": "remesh/state-2"})
+    failure = freefem.NewtonFailure({"increment": 10, "load_factor": 0.5, "reason": "mesh would invert"})
+    return scene, state, failure
+
+
+def test_a_scheduled_remesh_that_cannot_be_reequilibrated_is_dropped_and_the_old_mesh_goes_on(tmp_path):
+    scene, state, failure = _reequilibrating(False, 0)
+    said = []
+    cut_step(scene, RunFiles(tmp_path), state, failure, said.append)
+    assert not state.reequilibrate and state.remeshes == [] and len(state.segments) == 1
+    assert state.pending == [0.55, 0.6] and state.last == (9, 0.5)
+    kept = json.loads((tmp_path / "failed-attempts" / "remesh-2-after-9.json").read_text())
+    assert kept["algorithm_2d_tries"] == len(AGAIN)
+    assert "going on with the mesh before it (min quality 0.11)" in said[-1]
+
+
+@pytest.mark.parametrize("after_failed_step, inverted, quality", [(True, 0, 0.11), (False, 3, 0.11), (False, 0, 0.049)])
+def test_a_reequilibration_that_fails_for_good_stops_and_says_so(tmp_path, after_failed_step, inverted, quality):
+    # made because a step failed (no second chance), the old mesh has inverted cells or is below half of
+    # remesh.min_quality (0.1): stop, say what failed
+    scene, state, failure = _reequilibrating(after_failed_step, inverted, quality)
+    with pytest.raises(StepCutError) as err:
+        cut_step(scene, RunFiles(tmp_path), state, failure, lambda *_: None)
+    text = str(err.value)
+    assert f"mesh would invert in the re-equilibration after remesh 2, even in {RELAX_MAX} stages on 3 meshes" in text
+    assert "1 accepted increments are kept" in text
+    assert json.loads((tmp_path / "stopped.json").read_text())["increment"] == 10
+
+
+@pytest.mark.parametrize("on_failure, first", [(False, 1), (True, 9)])
+def test_a_step_that_fails_for_good_stops_without_a_remesh_when_it_may_not(tmp_path, on_failure, first):
+    # remesh.on_failure = false, or the last converged increment is the first on its mesh (remeshed already)
+    scene = fe_scene(load(WORKFLOWS / "cutting-aisi1045.toml", smoke=True))
+    scene.remesh.on_failure = on_failure
+    lf = 0.5 + scene.loading.nominal_step() / 2 ** (scene.loading.max_cuts + 1)
+    state = State(accepted=[(9, 0.5)], pending=[lf, 0.75])
+    state.segments[0]["first"] = first
+    failure = freefem.NewtonFailure({"increment": 10, "load_factor": lf, "reason": "mesh would invert"})
+    with pytest.raises(StepCutError) as err:
+        cut_step(scene, RunFiles(tmp_path), state, failure, lambda *_: None)
+    assert "even after" in str(err.value) and state.remeshes == []
+
+
+def test_a_step_that_fails_for_good_is_remeshed_once(tmp_path):
+    # A real cut (the steel scene's smoke, 4 increments of 5 um) whose next step is made to fail in its smallest
+    # cut: the last converged increment is remeshed (gmsh, transfer), the run re-equilibrates on the new mesh
+    # (resumed, as the loop goes on after the remesh) and ends there; a second failure on that mesh stops it.
+    from wendel.cutting.fe_run import run_cut
+    from wendel.loop.checkpoint import load_state, save
+    from wendel.loop.quasistatic import run
+    steel = WORKFLOWS / "cutting-aisi1045.toml"
+    root = run_cut(load(steel, smoke=True), steel, tmp_path / "cut", smoke=True, progress=lambda *_: None,
+                   frames=False)
+    files, scene, state, dimension = load_state(root)
+    last, lf_last = state.last
+    assert state.pending == [] and scene.remesh.on_failure
+    lf = lf_last + scene.loading.nominal_step() / 2 ** (scene.loading.max_cuts + 1)
+    state.pending = [lf]
+    said = []
+    cut_step(scene, files, state, freefem.NewtonFailure({"increment": last + 1, "load_factor": lf,
+                                                         "reason": "mesh would invert"}), said.append, dimension)
+    rep = state.remeshes[-1]
+    assert rep["after_failed_step"] and rep["after_increment"] == last and state.reequilibrate
+    assert state.pending == [lf_last] and (root / state.segments[-1]["mesh"]).is_file()
+    assert any("remeshing increment" in s and "remesh.on_failure" in s for s in said)
+    save(files, scene, state, dimension)
+    run("", resume=root, progress=lambda *_: None)
+    files, scene, state, dimension = load_state(root)
+    assert state.last == (last + 1, lf_last) and not state.reequilibrate
+    rows = list(csv.DictReader((root / "history.csv").open()))
+    assert rows[-1]["increment"] == str(last + 1) and rows[-1]["reequilibration"] == "1"
+    state.pending = [lf]        # fails again right after the remesh: no second one
+    with pytest.raises(StepCutError):
+        cut_step(scene, files, state, freefem.NewtonFailure({"increment": last + 2, "load_factor": lf,
+                                                             "reason": "mesh would invert"}), said.append, dimension)
+    assert len(state.remeshes) == len(json.loads((root / "summary.json").read_text())["remeshes"])
