@@ -107,6 +107,8 @@ def test_bad_zones_are_refused_with_the_key(tmp_path):
     ("cutting-mesh", "WENDEL_BENCH_EDGES", "3,4,5,2",
      "WENDEL_BENCH_EDGES = '3,4,5,2': three different whole numbers from 2 to 8, the edge radius over the edge size "
      "(e.g. 3,4,5), and optionally one of them again, cut at half the step"),
+    ("cutting-steady-fbar", "WENDEL_BENCH_EDGE", "1",
+     "WENDEL_BENCH_EDGE = '1': a whole number from 2 to 8, the edge radius over the edge size"),
     ("cutting-kienzle", "WENDEL_BENCH_FBAR", "2",
      "WENDEL_BENCH_FBAR = '2': 1 (cutting.volumetric = \"fbar\"), 0 (\"cell\") or unset (as the scene says)"),
 ])

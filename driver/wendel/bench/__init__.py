@@ -97,6 +97,23 @@ def edges(default: list[tuple[str, int, int]]) -> list[tuple[str, int, int]]:
     return [(f"r/{a}", a, 1), (f"r/{c}", c, 1), (f"r/{b}", b, 1), (f"r/{half}, half step", half, 2)]
 
 
+def cut_mm() -> float:
+    """``WENDEL_BENCH_CUT_MM`` (default 2.4) [mm], refused by name outside (1.2, 20]."""
+    mm = float(os.environ.get("WENDEL_BENCH_CUT_MM", "2.4"))
+    if not 1.2 < mm <= 20.0:
+        raise ValueError(f"WENDEL_BENCH_CUT_MM = {mm}: a length of cut in mm above 1.2 (cutting-steady's) and up to 20")
+    return mm
+
+
+def edge() -> int:
+    """``WENDEL_BENCH_EDGE`` of the long cutting benches: the edge size r / that whole number (2-8), default 2 (r/2);
+    anything else refused by name. Session 21: with conduction F-bar needs r/3 or finer (README)."""
+    v = os.environ.get("WENDEL_BENCH_EDGE", "2")
+    if not (v.isdigit() and 2 <= int(v) <= 8):
+        raise ValueError(f"WENDEL_BENCH_EDGE = {v!r}: a whole number from 2 to 8, the edge radius over the edge size")
+    return int(v)
+
+
 def register(name: str):
     """Register a benchmark ``func(quick, workdir) -> rows`` under ``name``."""
 

@@ -31,12 +31,11 @@ from pathlib import Path
 
 import numpy as np
 
-from . import WORKFLOWS, edges, env_flag, heat, register, volumetric
+from . import WORKFLOWS, cut_mm, edge, edges, env_flag, heat, register, volumetric
 
 WINDOW = 160e-6  # m: the compared window, the last 160 um of travel (4 remesh cycles of 40 um without step cuts)
 STEPS = 80       # increments of 5 um: the first 400 um (2.7 h) of the scene's 600 um cut
-CASES = [("r/2", 2, 1), ("r/4", 4, 1), ("r/3", 3, 1), ("r/2, half step", 2, 2)]
-"""(name, edge radius / edge size, increments per 5 um)."""
+CASES = [("r/2", 2, 1), ("r/4", 4, 1), ("r/3", 3, 1), ("r/2, half step", 2, 2)]  # name, r / edge size, increments per 5 um
 
 
 def _scene(divide: int, substeps: int, quick: bool, vol: str | None = None):
@@ -194,14 +193,16 @@ def cutting_steady_bench(quick: bool, workdir: Path) -> list[dict]:
     window's spreads and drifts, and where the running means over one h settle (``filtered``). ``--quick``:
     400 um. ``WENDEL_BENCH_SNAP=1`` (also for ``cutting-steady-fbar`` and ``cutting-long``): with
     ``cutting.snap_to_tool`` (folder ``...-snap``); ``WENDEL_BENCH_CONDUCTION=1``: with heat conduction and
-    frictional heat (``thermal.coupling = "staggered"``, as ``cutting-heat``; folder ``...-conduction``)."""
+    frictional heat (``thermal.coupling = "staggered"``, as ``cutting-heat``; folder ``...-conduction``);
+    ``WENDEL_BENCH_EDGE``: the edge size r / that whole number (2-8; folder ``r<n>-...``) instead of r/2."""
     return _steady(quick, workdir, "cell")
 
 
 @register("cutting-steady-fbar")
 def cutting_steady_fbar_bench(quick: bool, workdir: Path) -> list[dict]:
     """``cutting-steady`` with F-bar (``cutting.volumetric = "fbar"``): the same 1.2 mm cut at edge r/2, its
-    own folder and rows (an hour or more on one core; ``--quick``: 400 um). ``WENDEL_BENCH_REMESH_EVERY``: remesh
+    own folder and rows (an hour or more on one core; ``--quick``: 400 um; ``WENDEL_BENCH_EDGE``: another edge, as
+    ``cutting-steady``). ``WENDEL_BENCH_REMESH_EVERY``: remesh
     after that many increments instead of the scene's 8 (folder ``r2-long-remeshN``; session 14: 6 reaches 1.2 mm);
     ``WENDEL_BENCH_CUT_MM``: a longer cut [mm] on a block 1.4 mm longer, as ``cutting-long`` (folder
     ``r2-fbar-<um>um[-remeshN]``, with ``cutting-long``'s means over each 150 um and the last 1.5 mm)."""
@@ -212,18 +213,9 @@ def cutting_steady_fbar_bench(quick: bool, workdir: Path) -> list[dict]:
     every = int(every) if every else None
     if "WENDEL_BENCH_CUT_MM" not in os.environ:
         return _steady(quick, workdir, "fbar", remesh_every=every)
-    mm = _cut_mm()
+    mm = cut_mm()
     return _steady(quick, workdir, "fbar", remesh_every=every, length=mm * 1e-3, block=(mm + 1.4) * 1e-3,
                    folder=f"r2-fbar-{mm * 1e3:.0f}um" + (f"-remesh{every}" if every else ""))
-
-
-def _cut_mm() -> float:
-    """``WENDEL_BENCH_CUT_MM`` (default 2.4) [mm], refused by name outside (1.2, 20]."""
-    import os
-    mm = float(os.environ.get("WENDEL_BENCH_CUT_MM", "2.4"))
-    if not 1.2 < mm <= 20.0:
-        raise ValueError(f"WENDEL_BENCH_CUT_MM = {mm}: a length of cut in mm above 1.2 (cutting-steady's) and up to 20")
-    return mm
 
 
 @register("cutting-long")
@@ -232,7 +224,7 @@ def cutting_long_bench(quick: bool, workdir: Path) -> list[dict]:
     whether the forces settle after the 1.2 mm, with the means over each 150 um of travel (``bin`` rows) and
     over the last 1.5 mm (``mean_*`` in the last row). ``WENDEL_BENCH_CUT_MM``: another length [mm] (the block 1.4 mm
     longer, its own folder). ``--quick``: the 400 um of ``cutting-steady --quick``."""
-    mm = _cut_mm()
+    mm = cut_mm()
     return _steady(quick, workdir, "cell", length=mm * 1e-3, block=(mm + 1.4) * 1e-3, folder=f"r2-{mm * 1e3:.0f}um")
 
 
@@ -244,8 +236,10 @@ def _steady(quick: bool, workdir: Path, vol: str, remesh_every: int | None = Non
     import csv
 
     from ..cutting.fe_steady import steady, window
-    scene = _scene(2, 1, quick=False, vol=vol)
+    div = edge()                # WENDEL_BENCH_EDGE: the edge size r / div (folder r<div>-...), default r/2
+    scene = _scene(div, 1, quick=False, vol=vol)
     folder = folder or ("r2-long" if not remesh_every else f"r2-long-remesh{remesh_every}")
+    folder = folder.replace("r2", f"r{div}", 1)
     if env_flag("WENDEL_BENCH_SNAP", "cutting.snap_to_tool"):
         scene.cutting.snap_to_tool, folder = True, folder + "-snap"
     if env_flag("WENDEL_BENCH_CONDUCTION", 'thermal.coupling = "staggered"'):
