@@ -2,7 +2,8 @@
 
 A re-equilibration after a scheduled remesh that fails in the most stages on every gmsh mesh drops the remesh and
 goes on with the old mesh (when no cell of it is inverted); a forward step that fails even in its smallest cut is
-remeshed once and tried again (``remesh.on_failure``); what cannot go on stops with a message that says what
+remeshed once and tried again (``remesh.on_failure``); F-bar re-equilibrates once with the cells' own volume change
+before it gives a remesh up; what cannot go on stops with a message that says what
 failed and keeps the accepted increments. The decisions are made on the loop's state, without FreeFEM (the remesh
 of a forward failure is a real one in ``test_a_step_that_fails_for_good_is_remeshed_once``)."""
 
@@ -22,8 +23,10 @@ from wendel.scene import load
 from conftest import WORKFLOWS
 
 
-def _reequilibrating(after_failed_step: bool, inverted: int, quality: float = 0.11):
-    scene = fe_scene(load(WORKFLOWS / "cutting-aisi1045.toml", smoke=True))
+def _reequilibrating(after_failed_step: bool, inverted: int, quality: float = 0.11, volumetric: str = "cell"):
+    cut = load(WORKFLOWS / "cutting-aisi1045.toml", smoke=True)
+    cut.cutting.volumetric = volumetric
+    scene = fe_scene(cut)
     rep = {"remesh": 2, "after_increment": 9, "relax_steps": RELAX_MAX, "algorithm_2d_tries": len(AGAIN),
            "dimension": 2, "min_quality_before": quality, "inverted_before": inverted,
            "after_failed_step": after_failed_step}
@@ -43,6 +46,21 @@ def test_a_scheduled_remesh_that_cannot_be_reequilibrated_is_dropped_and_the_old
     kept = json.loads((tmp_path / "failed-attempts" / "remesh-2-after-9.json").read_text())
     assert kept["algorithm_2d_tries"] == len(AGAIN)
     assert "going on with the mesh before it (min quality 0.11)" in said[-1]
+
+
+def test_fbar_reequilibrates_once_with_the_cells_own_volume_change_before_it_drops_the_remesh(tmp_path):
+    # F-bar's re-equilibration failed in the most stages on every mesh: that increment once more with the cells'
+    # own volume change (F-bar from the next; quasistatic.solve swaps -ul_volumetric for that launch only), at the
+    # scene's stages; when that fails too, the remesh is dropped as without F-bar
+    scene, state, failure = _reequilibrating(False, 0, volumetric="fbar")
+    said = []
+    cut_step(scene, RunFiles(tmp_path), state, failure, said.append)
+    rep = state.remeshes[-1]
+    assert rep["relax_cell"] is True and rep["relax_steps"] == scene.remesh.relax_steps and state.reequilibrate
+    assert state.pending == [0.5, 0.55, 0.6] and "cells' own volume change" in said[-1]
+    rep["relax_steps"] = RELAX_MAX
+    cut_step(scene, RunFiles(tmp_path), state, failure, said.append)
+    assert not state.reequilibrate and state.remeshes == [] and "going on with the mesh before it" in said[-1]
 
 
 @pytest.mark.parametrize("after_failed_step, inverted, quality", [(True, 0, 0.11), (False, 3, 0.11), (False, 0, 0.049)])
@@ -73,15 +91,16 @@ def test_a_step_that_fails_for_good_stops_without_a_remesh_when_it_may_not(tmp_p
 
 
 def test_a_step_that_fails_for_good_is_remeshed_once(tmp_path):
-    # A real cut (the steel scene's smoke, 4 increments of 5 um) whose next step is made to fail in its smallest
-    # cut: the last converged increment is remeshed (gmsh, transfer), the run re-equilibrates on the new mesh
+    # A real cut (the steel scene's smoke with F-bar, 4 increments of 5 um) whose next step is made to fail in its
+    # smallest cut: the last converged increment is remeshed (gmsh, transfer), the run re-equilibrates on the new mesh
     # (resumed, as the loop goes on after the remesh) and ends there; a second failure on that mesh stops it.
     from wendel.cutting.fe_run import run_cut
     from wendel.loop.checkpoint import load_state, save
     from wendel.loop.quasistatic import run
     steel = WORKFLOWS / "cutting-aisi1045.toml"
-    root = run_cut(load(steel, smoke=True), steel, tmp_path / "cut", smoke=True, progress=lambda *_: None,
-                   frames=False)
+    cut = load(steel, smoke=True)
+    cut.cutting.volumetric = "fbar"
+    root = run_cut(cut, steel, tmp_path / "cut", smoke=True, progress=lambda *_: None, frames=False)
     files, scene, state, dimension = load_state(root)
     last, lf_last = state.last
     assert state.pending == [] and scene.remesh.on_failure
@@ -94,8 +113,11 @@ def test_a_step_that_fails_for_good_is_remeshed_once(tmp_path):
     assert rep["after_failed_step"] and rep["after_increment"] == last and state.reequilibrate
     assert state.pending == [lf_last] and (root / state.segments[-1]["mesh"]).is_file()
     assert any("remeshing increment" in s and "remesh.on_failure" in s for s in said)
+    rep["relax_cell"] = True        # as after F-bar's failed re-equilibrations: with the cells' own volume change
     save(files, scene, state, dimension)
     run("", resume=root, progress=lambda *_: None)
+    words = [ln for ln in (root / "freefem.log").read_text().splitlines() if ln.startswith("$ ")][-1].split()
+    assert words[words.index("-ul_volumetric") + 1] == "0" and scene.kinematics.volumetric == "fbar"
     files, scene, state, dimension = load_state(root)
     assert state.last == (last + 1, lf_last) and not state.reequilibrate
     rows = list(csv.DictReader((root / "history.csv").open()))

@@ -169,11 +169,8 @@ def build(scene: Scene, files: RunFiles) -> tuple[float, int]:
 
 
 def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress) -> None:
-    """Launch FreeFEM on the pending increments; cut failing steps; remesh when the mesh distorts.
-
-    Without remeshing one launch runs all pending increments (start-up paid once); with remeshing one
-    launch runs a remeshing segment (FreeFEM ends it after a poor mesh, :mod:`wendel.remesh.batch`).
-    """
+    """Launch FreeFEM on the pending increments (all in one launch without remeshing; with it, a launch a remeshing
+    segment, ended by FreeFEM after a poor mesh: :mod:`wendel.remesh.batch`); cut failing steps; remesh."""
     write_tables(scene, files, dimension)
     if scene.remesh:            # imported while FreeFEM solves the first segment, not at the first remesh
         overlap.preload("wendel.remesh.transfer", "wendel.remesh.mesher")
@@ -185,8 +182,9 @@ def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress)
             plan_step(scene, state)
         was_reequilibration = state.reequilibrate
         batch, stop_args = remesh_batch.plan(scene, state, dimension)
-        if separated.watching(scene, state):
-            batch = batch[:1]           # the driver looks for a separation after every DG increment
+        relax_cell = state.reequilibrate and state.remeshes[-1].get("relax_cell", False)     # steps.cut_step
+        if separated.watching(scene, state) or relax_cell:     # a separation is looked for after every DG increment;
+            batch = batch[:1]           # F-bar's last resort re-equilibrates alone with the cells' own volume change
         (files.fem / remesh_batch.STOP_FILE).unlink(missing_ok=True)
         loads = files.tables / "loads.txt"
         loads.write_text(f"{len(batch)}\n" + "".join(f"{lf!r}\n" for lf in batch))
@@ -195,6 +193,8 @@ def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress)
         if state.reequilibrate:
             opts += ["-restart", str(files.root / seg["state"]), "-relax_steps",
                      str(state.remeshes[-1].get("relax_steps") or scene.remesh.relax_steps)]
+            if relax_cell:
+                opts[opts.index("-ul_volumetric") + 1] = "0"
         elif state.accepted:
             opts += ["-restart", str(files.fem / f"inc-{state.last[0]:04d}")]
         watcher = _Progress(files.fem, inc0, len(batch), batch, progress)
