@@ -98,10 +98,15 @@ def cut_step(scene: Scene, files: RunFiles, state: State, failure: freefem.Newto
             f"{len(state.accepted)} accepted increments are kept in {files.root}" + _hint(scene, reason))
     if scene.loading.adaptive:
         state.step = abs(mid - lf_prev)
-        if all(abs(lf_fail - t) > 1e-12 * max(1.0, abs(t)) for t in scene.loading.load_factors()):
+        if not _target(scene, lf_fail):
             state.pending.pop(0)         # an intermediate point of the adaptive loading: plan_step re-plans
     state.pending.insert(0, mid)
     progress(f"  increment {inc}: {reason} at load factor {lf_fail:g}; cutting the step to {mid:g}")
+
+
+def _target(scene: Scene, lf: float) -> bool:
+    """Whether ``lf`` is one of the loading's target load factors (not a point a cut or the adaptive loading put in)."""
+    return any(abs(lf - t) <= 1e-12 * max(1.0, abs(t)) for t in scene.loading.load_factors())
 
 
 def _keep_old_mesh(scene: Scene, files: RunFiles, state: State, progress, inc: int) -> bool:
@@ -110,14 +115,12 @@ def _keep_old_mesh(scene: Scene, files: RunFiles, state: State, progress, inc: i
     remesh and go on with the old mesh, remeshed again when its quality or the schedule next says. Measured on
     the FE cut (README, session 21): the F-bar cuts with conduction that stopped so had remeshed on schedule at a
     min SICN of 0.11-0.24."""
+    from ..remesh.again import drop_last_remesh
     rep = state.remeshes[-1]
     if rep.get("after_failed_step") or rep.get("inverted_before", 1) > 0 \
             or rep.get("min_quality_before", 0.0) < 0.5 * scene.remesh.min_quality:
         return False
-    state.remeshes.pop()
-    state.segments.pop()
-    state.pending.pop(0)
-    state.reequilibrate = False
+    drop_last_remesh(state)
     keep = files.root / "failed-attempts"
     keep.mkdir(exist_ok=True)
     (keep / f"remesh-{rep.get('remesh')}-after-{rep.get('after_increment')}.json").write_text(json.dumps(rep, indent=1))
@@ -137,8 +140,7 @@ def _remesh(scene: Scene, files: RunFiles, state: State, dimension: int, progres
             and last > state.segments[-1]["first"] and len(state.remeshes) < r.max_remeshes):
         return False
     from ..remesh.step import maybe_remesh
-    targets = scene.loading.load_factors()
-    state.pending = [p for p in state.pending if any(abs(p - t) <= 1e-12 * max(1.0, abs(t)) for t in targets)]
+    state.pending = [p for p in state.pending if _target(scene, p)]
     if scene.loading.adaptive:
         state.step = scene.loading.nominal_step()
     progress(f"  increment {inc}: {reason}, even after {scene.loading.max_cuts} step halvings: remeshing "

@@ -19,15 +19,22 @@ def remesh_again(scene, files, state, progress) -> bool:
     tried = rep.get("algorithm_2d_tries", 0)
     if rep.get("dimension") != 2 or tried >= len(AGAIN):
         return False
-    state.remeshes.pop()
-    state.segments.pop()
-    state.pending.pop(0)
-    state.reequilibrate = False
+    drop_last_remesh(state)
     progress(f"  increment {rep['after_increment']}: the re-equilibration failed; meshing again with gmsh algorithm "
              f"{AGAIN[tried]}")
     from .step import maybe_remesh
     maybe_remesh(scene, files, state, 2, progress, again=tried + 1, failed=rep.get("after_failed_step", False))
     return True
+
+
+def drop_last_remesh(state) -> dict:
+    """Undo the last remesh whose re-equilibration failed (its report, mesh segment and re-equilibration load
+    factor): the loop stands after the increment it was made from, on the mesh before it. Its report."""
+    rep = state.remeshes.pop()
+    state.segments.pop()
+    state.pending.pop(0)
+    state.reequilibrate = False
+    return rep
 
 
 def made_or_failed(remesh, k: int, inc: int, lf: float, quality: dict, root):
