@@ -303,3 +303,21 @@ def test_transient_coupled_square_agrees_with_small_strain_to_the_strain_order(t
     assert np.abs(ul[2]["u"] - ss[2]["u"]).max() < 3e-3 * np.abs(ss[2]["u"]).max()
     assert np.abs(ul[1]["vonMises"] - ss[1]["vonMises"]).max() < 3e-3 * ss[1]["vonMises"].max()
 
+
+
+def test_staggered_heat_without_thermal_stress_matches_the_monolithic_solution(tmp_path, scene_file, quiet):
+    """With no thermal expansion (alpha = 0) the staggered step solves the heat equation and then the mechanics
+    without the coupling block K_uT (zero; thermal.idp skips its assembly): the stretched block (plane strain),
+    heated for 2000 s from its ends (not yet steady), has the monolithic coupling's temperatures and positions
+    to the Newton tolerance, in as many Newton iterations."""
+    text = STRETCH.replace("duration = 0.0    # s (0: steady)", "duration = 2000.0    # s")
+    assert "duration = 2000.0" in text
+    runs = {c: last(go(scene_file, text.replace('coupling = "monolithic"', f'coupling = "{c}"'), tmp_path, quiet, c))
+            for c in ("monolithic", "staggered")}
+    Tm, Ts = runs["monolithic"][2]["T"], runs["staggered"][2]["T"]
+    assert Tm.max() - Tm.min() > 50 and np.abs(Tm - 300.0).max() > 5      # transient: not the linear profile
+    assert np.abs(Tm - Ts).max() < 1e-8 * Tm.max(), np.abs(Tm - Ts).max() / Tm.max()
+    pm, ps = runs["monolithic"][2]["position"], runs["staggered"][2]["position"]
+    assert np.abs(pm - ps).max() < 1e-10
+    # no coupling left out: the staggered step is the whole Newton step, as many iterations
+    assert runs["staggered"][0]["newton_iterations"] == runs["monolithic"][0]["newton_iterations"]
