@@ -107,3 +107,46 @@ def test_bad_petsc_options_refused(tmp_path, options, why):
     assert r.returncode == 2
     assert "numerics.petsc.options" in r.stderr and why in r.stderr and "bad.toml" in r.stderr
     assert "Traceback" not in r.stderr
+
+
+def test_mumps_direct_agrees_with_umfpack_on_contact_plasticity(tmp_path, ball_direct):
+    """numerics.direct = "mumps": the direct solve by MUMPS's LU through the plugin, the same iterates as UMFPACK64."""
+    path = WORKFLOWS / "ball-indent.toml"
+    scene = load(path, smoke=True)
+    scene.numerics.solver, scene.numerics.direct, scene.output.png = "direct", "mumps", False
+    root = run_scene(scene, path, tmp_path / "mumps", smoke=True, progress=lambda *_: None)
+    m = json.loads((root / "summary.json").read_text())
+    assert "-DWITHPETSCLU=1" in (root / "freefem.log").read_text()
+    ld, lm = ball_direct["last_increment"], m["last_increment"]
+    for key in ("contact_force", "max_displacement", "max_von_mises"):
+        assert lm[key] == pytest.approx(ld[key], rel=1e-9), key
+    assert m["newton_iterations"] == ball_direct["newton_iterations"]
+    assert lm["contact_active_nodes"] == ld["contact_active_nodes"] > 0
+
+
+def test_mumps_direct_solves_the_frictional_fbar_cut(tmp_path):
+    """The FE cut's Newton matrix (friction: not symmetric; F-bar: 36 entries a row) by MUMPS: the steel scene's
+    smoke cut with F-bar gives UMFPACK64's forces."""
+    from wendel.cutting.fe_run import run_cut
+    steel = WORKFLOWS / "cutting-aisi1045.toml"
+    forces = {}
+    for lib in ("umfpack", "mumps"):
+        cut = load(steel, smoke=True)
+        cut.cutting.volumetric = "fbar"
+        cut.numerics.direct = lib
+        root = run_cut(cut, steel, tmp_path / lib, smoke=True, progress=lambda *_: None, frames=False)
+        forces[lib] = [float(r.split(",")[3]) for r in (root / "cutting.csv").read_text().splitlines()[1:]]
+        assert ("-DWITHPETSCLU=1" in (root / "freefem.log").read_text()) == (lib == "mumps")
+    assert len(forces["mumps"]) == len(forces["umfpack"]) >= 4
+    assert forces["mumps"] == pytest.approx(forces["umfpack"], rel=1e-8)
+
+
+def test_mumps_is_refused_beside_an_iterative_solver(tmp_path):
+    scene = tmp_path / "bad.toml"
+    text = (WORKFLOWS / "ball-indent.toml").read_text()
+    assert 'solver = "petsc"' in text
+    scene.write_text(text.replace('solver = "petsc"', 'solver = "petsc"\ndirect = "mumps"', 1))
+    r = subprocess.run([sys.executable, "-m", "wendel.cli", "check", str(scene)], capture_output=True, text=True)
+    assert r.returncode == 2
+    assert "numerics" in r.stderr and "solver = \"direct\"" in r.stderr and "bad.toml" in r.stderr
+    assert "Traceback" not in r.stderr

@@ -229,10 +229,11 @@ def cutting_long_bench(quick: bool, workdir: Path) -> list[dict]:
 
 
 def _steady(quick: bool, workdir: Path, vol: str, remesh_every: int | None = None,
-            length: float = 1.2e-3, block: float = 2.6e-3, folder: str | None = None) -> list[dict]:
+            length: float = 1.2e-3, block: float = 2.6e-3, folder: str | None = None, reuse: bool = False) -> list[dict]:
     """The 1.2 mm cut of ``cutting-steady`` (or ``length`` [m] on a block ``block`` [m] long, in ``folder``) with
     ``vol`` (and ``remesh_every`` increments between remeshes instead of the scene's 8, if given): the remesh-cycle
-    means, then a row of the last window's spreads and drifts, increments, step cuts, Newton iterations, wall time."""
+    means, then a row of the last window's spreads and drifts, increments, step cuts, Newton iterations, wall time.
+    ``reuse``: a finished cut of the same scene in the folder is read, not run again (its summary's wall time)."""
     import csv
 
     from ..cutting.fe_steady import steady, window
@@ -252,19 +253,23 @@ def _steady(quick: bool, workdir: Path, vol: str, remesh_every: int | None = Non
     if remesh_every:
         scene.cutting.remesh_every = remesh_every
     out = workdir / folder
-    shutil.rmtree(out, ignore_errors=True)
+    reused = reuse and _finished(out, scene)
+    if not reused:
+        shutil.rmtree(out, ignore_errors=True)
     from ..cutting.fe_run import run_cut
     from ..errors import StepCutError
     from ..freefem import FreeFemError, NewtonFailure
     stopped = ""
     t0 = time.perf_counter()
     try:
-        run_cut(scene, WORKFLOWS / "cutting-aisi1045.toml", out, smoke=False, progress=lambda *_: None, frames=True)
+        if not reused:
+            run_cut(scene, WORKFLOWS / "cutting-aisi1045.toml", out, smoke=False, progress=lambda *_: None, frames=True)
     except (NewtonFailure, StepCutError, FreeFemError) as exc:
         stopped = str(exc).split(";")[0]
-    wall = time.perf_counter() - t0
     rows = [{k: float(v) for k, v in r.items()} for r in csv.DictReader((out / "cutting.csv").open())]
     s = json.loads((out / "summary.json").read_text()) if (out / "summary.json").is_file() else {}
+    wall = s.get("wall_time", float("nan")) if reused else time.perf_counter() - t0
+    stopped = stopped or ("" if s.get("completed", True) else "stopped before the end (summary.json)")
     st = steady(rows, scene.cutting.uncut_thickness)
     res = []
     for c in st["cycle_means"]:

@@ -174,7 +174,9 @@ def fe_scene(scene, travel: float = 1.0) -> Scene:
         # the return mapping solves it, plasticity.idp's plastAd)
         # predictor: each increment starts from the last one's motion extrapolated (the tool moves steadily; the
         # first guess from u_n met the tool 5 um deep: 30-40 % fewer Newton iterations, measured in session 8)
-        "numerics": {"solver": "direct", "newton_tol": 1e-8, "newton_maxit": 100, "predictor": "extrapolate"},
+        # direct: the scene's factorization (numerics.direct = "mumps": MUMPS, faster on F-bar's denser matrix)
+        "numerics": {"solver": "direct", "newton_tol": 1e-8, "newton_maxit": 100, "predictor": "extrapolate",
+                     "direct": scene.numerics.direct},
         "output": {"png": False, "vtu": True},
         "remesh": remesh,
     }

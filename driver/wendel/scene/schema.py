@@ -190,6 +190,10 @@ class Numerics(Strict):
 
     ranks: int = Field(1, ge=1, le=64, description="MPI ranks")
     solver: SolverName = Field("direct", description=f"linear solver: {', '.join(SOLVERS)}")
+    direct: Literal["umfpack", "mumps"] = Field("umfpack", description="the direct solver's factorization: "
+                                                 "umfpack (FreeFEM's UMFPACK64) or mumps (MUMPS's LU through "
+                                                 "wendel's PETSc plugin; the same solution to round-off, faster "
+                                                 "on F-bar's denser matrices: wendel bench direct)")
     solver_tol: float = Field(1e-10, gt=0, lt=1, description="relative residual of iterative solvers [1]")
     newton_tol: float = Field(1e-9, gt=0, lt=1, description="relative Newton residual [1]")
     forcing: Literal["fixed", "ew"] = Field("fixed", description="tolerance of the Newton steps' iterative "
@@ -216,6 +220,9 @@ class Numerics(Strict):
         if self.ranks > 1 and self.solver not in ("ffddm", "petsc"):
             raise ValueError(f"solver {self.solver!r} runs on one rank; use solver = \"ffddm\" or \"petsc\" "
                              f"with ranks = {self.ranks}")
+        if self.direct != "umfpack" and self.solver != "direct":
+            raise ValueError(f"direct = {self.direct!r} chooses the direct solver's factorization: it needs "
+                             f"solver = \"direct\", not {self.solver!r}")
         if self.forcing != "fixed" and self.solver not in ("cg", "petsc"):
             raise ValueError(f"forcing = {self.forcing!r} needs an iterative solver: solver = \"cg\" or \"petsc\"")
         return self
