@@ -131,3 +131,17 @@ def test_the_mesh_bench_takes_its_three_edges_from_the_environment(monkeypatch):
     assert edges(CASES) == [("r/3", 3, 1), ("r/5", 5, 1), ("r/4", 4, 1), ("r/3, half step", 3, 2)]
     monkeypatch.setenv("WENDEL_BENCH_EDGES", "3,4,5,4")
     assert edges(CASES)[3] == ("r/4, half step", 4, 2)
+
+
+def test_the_steady_mesh_bench_neither_deletes_nor_reruns_an_unfinished_cut(tmp_path, monkeypatch):
+    # session 22: the bench started while another process still wrote a finished cut's frames, took the folder for
+    # a stale one, deleted it and cut again; now an unfinished folder is refused and left as it is
+    from wendel.bench.cutting_mesh import _steady
+    monkeypatch.setenv("WENDEL_BENCH_EDGE", "4")
+    monkeypatch.setenv("WENDEL_BENCH_CONDUCTION", "1")
+    busy = tmp_path / "r4-long-conduction"
+    busy.mkdir()
+    (busy / "history.csv").write_text("increment\n1\n")
+    with pytest.raises(RuntimeError, match="unfinished cut"):
+        _steady(False, tmp_path, "fbar", reuse=True)
+    assert (busy / "history.csv").read_text() == "increment\n1\n"

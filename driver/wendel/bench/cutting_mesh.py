@@ -233,7 +233,7 @@ def _steady(quick: bool, workdir: Path, vol: str, remesh_every: int | None = Non
     """The 1.2 mm cut of ``cutting-steady`` (or ``length`` [m] on a block ``block`` [m] long, in ``folder``) with
     ``vol`` (and ``remesh_every`` increments between remeshes instead of the scene's 8, if given): the remesh-cycle
     means, then a row of the last window's spreads and drifts, increments, step cuts, Newton iterations, wall time.
-    ``reuse``: a finished cut of the same scene in the folder is read, not run again (its summary's wall time)."""
+    ``reuse``: a finished cut of the same scene in the folder is read (its summary's wall time), an unfinished one refused."""
     import csv
 
     from ..cutting.fe_steady import steady, window
@@ -254,8 +254,9 @@ def _steady(quick: bool, workdir: Path, vol: str, remesh_every: int | None = Non
         scene.cutting.remesh_every = remesh_every
     out = workdir / folder
     reused = reuse and _finished(out, scene)
-    if not reused:
-        shutil.rmtree(out, ignore_errors=True)
+    if reuse and not reused and out.exists():       # not deleted: it may be another process's cut in progress
+        raise RuntimeError(f"{out} holds an unfinished cut (running elsewhere?): let it finish, or delete the folder")
+    shutil.rmtree(out, ignore_errors=True) if not reused else None
     from ..cutting.fe_run import run_cut
     from ..errors import StepCutError
     from ..freefem import FreeFemError, NewtonFailure
