@@ -8,6 +8,7 @@ Ratios are always taken within one benchmark run.
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import json
 import os
@@ -19,7 +20,7 @@ from typing import Callable
 from ..loop import RESULTS
 
 BENCHES: dict[str, Callable[[bool, Path], list[dict]]] = {}
-OPT_IN = {"step42-dealii", "step42-pair", "step42-accuracy", "meshcache", "ranks", "overhead", "gmsh3d", "cutting", "cutting-isothermal", "cutting-mesh", "cutting-fbar", "cutting-steady", "cutting-steady-fbar", "cutting-steady-mesh", "direct", "cutting-long", "direct", "cutting-heat", "cutting-ti", "cutting-kienzle", "drilling-3d", "necking-fine", "sweep-warm"}
+OPT_IN = {"step42-dealii", "step42-pair", "step42-accuracy", "meshcache", "ranks", "overhead", "gmsh3d", "cutting", "cutting-isothermal", "cutting-mesh", "cutting-fbar", "cutting-steady", "cutting-steady-fbar", "cutting-steady-mesh", "direct", "cutting-long", "cutting-heat", "cutting-ti", "cutting-kienzle", "drilling-3d", "necking-fine", "sweep-warm"}
 """Run only when named: deal.II's step-42 needs extra Debian packages and 8 minutes; ``overhead`` runs
 every scene (twice with WENDEL_BENCH_BASE); the FE cuts take about 4 minutes each, the whole 3D deep bore (``drilling-3d``) about 7, the finer and remeshed necking bars (``necking-fine``) about 3."""
 
@@ -112,6 +113,28 @@ def edge() -> int:
     if not (v.isdigit() and 2 <= int(v) <= 8):
         raise ValueError(f"WENDEL_BENCH_EDGE = {v!r}: a whole number from 2 to 8, the edge radius over the edge size")
     return int(v)
+
+
+@contextlib.contextmanager
+def environ(**values: str):
+    """Set environment variables for the ``with`` block, each restored (or removed) after it.
+
+    >>> with environ(WENDEL_DOCTEST_X="1"):
+    ...     os.environ["WENDEL_DOCTEST_X"]
+    '1'
+    >>> "WENDEL_DOCTEST_X" in os.environ
+    False
+    """
+    old = {k: os.environ.get(k) for k in values}
+    os.environ.update(values)
+    try:
+        yield
+    finally:
+        for k, v in old.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
 
 
 def register(name: str):

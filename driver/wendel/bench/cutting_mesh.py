@@ -256,12 +256,12 @@ def _steady(quick: bool, workdir: Path, vol: str, remesh_every: int | None = Non
     reused = reuse and _finished(out, scene)
     if reuse and not reused and out.exists():       # not deleted: it may be another process's cut in progress
         raise RuntimeError(f"{out} holds an unfinished cut (running elsewhere?): let it finish, or delete the folder")
-    shutil.rmtree(out, ignore_errors=True) if not reused else None
+    if not reuse:                                   # (with reuse there is nothing to delete by now)
+        shutil.rmtree(out, ignore_errors=True)
     from ..cutting.fe_run import run_cut
     from ..errors import StepCutError
     from ..freefem import FreeFemError, NewtonFailure
-    stopped = ""
-    t0 = time.perf_counter()
+    stopped, t0 = "", time.perf_counter()
     try:
         if not reused:
             run_cut(scene, WORKFLOWS / "cutting-aisi1045.toml", out, smoke=False, progress=lambda *_: None, frames=True)

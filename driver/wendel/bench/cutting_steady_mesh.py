@@ -15,10 +15,9 @@ cuts in this bench's own folder, the last 100 um."""
 from __future__ import annotations
 
 import csv
-import os
 from pathlib import Path
 
-from . import edges, register
+from . import edges, environ, register
 
 WINDOW = 300e-6     # m: the last 2 h of the 1.2 mm
 DEFAULT = [("r/2", 2, 1), ("r/4", 4, 1), ("r/3", 3, 1)]
@@ -35,13 +34,8 @@ def cutting_steady_mesh_bench(quick: bool, workdir: Path) -> list[dict]:
     length = 100e-6 if quick else WINDOW
     rows = []
     for d in divs:
-        saved = {k: os.environ.get(k) for k in ("WENDEL_BENCH_EDGE", "WENDEL_BENCH_CONDUCTION", "WENDEL_BENCH_SNAP")}
-        os.environ.update({"WENDEL_BENCH_EDGE": str(d), "WENDEL_BENCH_CONDUCTION": "1", "WENDEL_BENCH_SNAP": "0"})
-        try:
+        with environ(WENDEL_BENCH_EDGE=str(d), WENDEL_BENCH_CONDUCTION="1", WENDEL_BENCH_SNAP="0"):
             last = _steady(quick, root, "fbar", reuse=True)[-1]
-        finally:
-            for k, v in saved.items():
-                os.environ.pop(k) if v is None else os.environ.__setitem__(k, v)
         cut = [{k: float(v) for k, v in r.items()}
                for r in csv.DictReader((root / f"r{d}-long-conduction" / "cutting.csv").open())]
         w = window(cut, length)

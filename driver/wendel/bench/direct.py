@@ -13,6 +13,7 @@ difference may cut another step, so its iterations may differ. ``--quick``: the 
 
 from __future__ import annotations
 
+import csv
 import json
 import resource
 import shutil
@@ -44,7 +45,7 @@ def _run(name: str, lib: str, quick: bool, out: Path) -> dict:
         scene.numerics.direct = lib
         root = run_cut(scene, WORKFLOWS / "cutting-aisi1045.toml", out, smoke=False, progress=lambda *_: None,
                        frames=False)
-        result = float((root / "cutting.csv").read_text().splitlines()[-1].split(",")[3])
+        result = float(list(csv.DictReader((root / "cutting.csv").open()))[-1]["Fc_N"])
     else:
         path = WORKFLOWS / f"{name}.toml"
         scene = load(path)

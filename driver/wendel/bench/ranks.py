@@ -13,11 +13,10 @@ before it (whole run and per Newton step: assembly + constitutive + solve). One 
 from __future__ import annotations
 
 import json
-import os
 from pathlib import Path
 
 from ..meshes.cache import ENV
-from . import WORKFLOWS, register
+from . import WORKFLOWS, environ, register
 from .petsc import measure
 
 PHASES = ("mesh", "freefem_startup", "assembly", "constitutive", "linear_solve", "freefem_output", "freefem_other",
@@ -45,16 +44,9 @@ def _row(out: Path, h: float, ranks: int) -> dict:
 def ranks(quick: bool, workdir: Path) -> list[dict]:
     """A cache-filling run, then 1, 2, 1, 2 ranks (see the module docstring)."""
     h = 0.1 if quick else 0.05
-    old = os.environ.get(ENV)
-    os.environ[ENV] = str(workdir / "cache")
-    try:
+    with environ(**{ENV: str(workdir / "cache")}):
         _row(workdir / "fill", h, 1)
         rows = [_row(workdir / f"run{i}-np{n}", h, n) for i, n in enumerate((1, 2, 1, 2))]
-    finally:
-        if old is None:
-            os.environ.pop(ENV, None)
-        else:
-            os.environ[ENV] = old
     for one, two in zip(rows[0::2], rows[1::2]):
         assert abs(two["contact_force"] - one["contact_force"]) <= 1e-7 * abs(one["contact_force"]), \
             "2 ranks must give the 1-rank force"

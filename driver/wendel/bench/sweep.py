@@ -18,7 +18,7 @@ import subprocess
 import time
 from pathlib import Path
 
-from . import register
+from . import environ, register
 
 ROOT = Path(__file__).resolve().parents[3]
 
@@ -70,26 +70,21 @@ def sweep_bench(quick: bool, workdir: Path) -> list[dict]:
     t0 = time.perf_counter()
     subprocess.run(["bash", str(script), "start", str(cluster)], check=True, capture_output=True, timeout=180)
     start_s = time.perf_counter() - t0
-    old = os.environ.get("SLURM_CONF")
-    os.environ["SLURM_CONF"] = str(cluster / "etc" / "slurm.conf")
     try:
-        sweep = _sweep_file(workdir, m, "slurm")
-        t0 = time.perf_counter()
-        rep = run_sweep(sweep, out=workdir / "slurm", executor="slurm", quiet=True, log=lambda *_: None)
-        rows.append({**_figures(rep, "slurm", m, time.perf_counter() - t0), "cluster_start_s": start_s})
-        sweep = _sweep_file(workdir, m, "slurm-per-task", per_task=m // 2)
-        t0 = time.perf_counter()
-        rep = run_sweep(sweep, out=workdir / "slurm-per-task", executor="slurm", quiet=True, log=lambda *_: None)
-        rows.append(_figures(rep, f"slurm, {m // 2} runs a task (warm)", m, time.perf_counter() - t0))
-        local = _sweep_file(workdir, m, "local-same")
-        t0 = time.perf_counter()
-        rep = run_sweep(local, out=workdir / "local-same", workers=2, quiet=True, log=lambda *_: None)
-        rows.append(_figures(rep, "local (same runs)", m, time.perf_counter() - t0))
+        with environ(SLURM_CONF=str(cluster / "etc" / "slurm.conf")):
+            sweep = _sweep_file(workdir, m, "slurm")
+            t0 = time.perf_counter()
+            rep = run_sweep(sweep, out=workdir / "slurm", executor="slurm", quiet=True, log=lambda *_: None)
+            rows.append({**_figures(rep, "slurm", m, time.perf_counter() - t0), "cluster_start_s": start_s})
+            sweep = _sweep_file(workdir, m, "slurm-per-task", per_task=m // 2)
+            t0 = time.perf_counter()
+            rep = run_sweep(sweep, out=workdir / "slurm-per-task", executor="slurm", quiet=True, log=lambda *_: None)
+            rows.append(_figures(rep, f"slurm, {m // 2} runs a task (warm)", m, time.perf_counter() - t0))
+            local = _sweep_file(workdir, m, "local-same")
+            t0 = time.perf_counter()
+            rep = run_sweep(local, out=workdir / "local-same", workers=2, quiet=True, log=lambda *_: None)
+            rows.append(_figures(rep, "local (same runs)", m, time.perf_counter() - t0))
     finally:
-        if old is None:
-            os.environ.pop("SLURM_CONF", None)
-        else:
-            os.environ["SLURM_CONF"] = old
         subprocess.run(["bash", str(script), "stop", str(cluster)], capture_output=True, timeout=120)
     return rows
 
@@ -110,11 +105,9 @@ def sweep_warm_bench(quick: bool, workdir: Path) -> list[dict]:
     workdir.mkdir(parents=True)
     n = 6 if quick else 20
     sweep = _sweep_file(workdir, n, "runs")
-    old = os.environ.get("WENDEL_SWEEP_WARM")
     rows = []
-    try:
-        for k, warm in enumerate(("0", "1", "0", "1")):
-            os.environ["WENDEL_SWEEP_WARM"] = warm
+    for k, warm in enumerate(("0", "1", "0", "1")):
+        with environ(WENDEL_SWEEP_WARM=warm):
             ru0, t0 = resource.getrusage(resource.RUSAGE_CHILDREN), time.perf_counter()
             rep = run_sweep(sweep, out=workdir / f"{k}-{'warm' if warm == '1' else 'cold'}", workers=2, quiet=True,
                             log=lambda *_: None)
@@ -122,12 +115,7 @@ def sweep_warm_bench(quick: bool, workdir: Path) -> list[dict]:
             row = _figures(rep, "local, warm" if warm == "1" else "local, cold", n, wall)
             row.update({"wall_per_run_s": wall / n, "cpu_per_run_s": (ru.ru_utime + ru.ru_stime - ru0.ru_utime - ru0.ru_stime) / n,
                         "load_average": os.getloadavg()[0]})
-            rows.append(row)
-    finally:
-        if old is None:
-            os.environ.pop("WENDEL_SWEEP_WARM", None)
-        else:
-            os.environ["WENDEL_SWEEP_WARM"] = old
+        rows.append(row)
 
     def med(label, key):
         return statistics.median(r[key] for r in rows if r["executor"] == label)

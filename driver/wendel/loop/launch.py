@@ -58,7 +58,7 @@ def macros(scene: Scene, dimension: int) -> list[str]:
         switches.append("-DWITHFRICTION=1")      # friction, tool, path or force control: edp/lib/friction.idp
     if scene.numerics.solver == "petsc":
         switches.append("-DWITHPETSC=1")       # loads wendel's PETSc plugin (lib/petsc.idp)
-    if scene.numerics.solver == "direct" and scene.numerics.direct == "mumps":
+    if scene.numerics.direct == "mumps":        # (the scene check ties it to solver = "direct")
         switches.append("-DWITHPETSCLU=1")     # MUMPS's LU through the same plugin (lib/solver.idp)
     switches += kernels.macros(scene, dimension)     # -DWITHKERNELS=1: compiled element kernels (lib/kernels.idp)
     return switches
