@@ -17,6 +17,7 @@ from wendel.cutting.fe import fe_scene, tool_at_start
 from wendel.cutting.fe_frames import rounded_outline
 from wendel.cutting.fe_run import run_cut
 from wendel.scene import load
+from wendel.scene.reading import SceneError
 
 from conftest import WORKFLOWS
 
@@ -160,3 +161,17 @@ def test_an_fbar_cut_that_tangles_stops_with_what_to_change(tmp_path, volumetric
     assert "mesh would invert, even after" in text and "1 accepted increments are kept" in text
     assert all(w in text for w in words), text
     assert ("F-bar (kinematics.volumetric" in text) == (volumetric == "fbar")
+
+
+def test_the_cut_takes_the_scenes_newton_tolerance_and_1e_8_without_one(tmp_path):
+    """numerics.newton_tol reaches the FE cut where the scene sets it (it was read and then overridden by the
+    cut's own 1e-8 until session 23); without it the cut keeps 1e-8, not the general scenes' 1e-9."""
+    assert fe_scene(load(STEEL)).numerics.newton_tol == 1e-8
+    text = STEEL.read_text()
+    assert "[numerics]" not in text
+    scene = tmp_path / "loose.toml"
+    scene.write_text(text + "\n[numerics]\nnewton_tol = 1.0e-6      # 1\n")
+    assert fe_scene(load(scene)).numerics.newton_tol == 1e-6
+    scene.write_text(text + "\n[numerics]\nnewton_maxit = 50\n")     # read and not used: refused, by file and key
+    with pytest.raises(SceneError, match=r"loose\.toml.*numerics\.newton_maxit.*only numerics\.direct, newton_tol"):
+        load(scene)

@@ -195,7 +195,8 @@ class Numerics(Strict):
                                                  "wendel's PETSc plugin; the same solution to round-off, faster "
                                                  "on F-bar's denser matrices: wendel bench direct)")
     solver_tol: float = Field(1e-10, gt=0, lt=1, description="relative residual of iterative solvers [1]")
-    newton_tol: float = Field(1e-9, gt=0, lt=1, description="relative Newton residual [1]")
+    newton_tol: float = Field(1e-9, gt=0, lt=1, description="relative Newton residual [1] (a cutting "
+                              "scene's FE cut: 1e-8 unless set)")
     forcing: Literal["fixed", "ew"] = Field("fixed", description="tolerance of the Newton steps' iterative "
                                             "solves (cg, petsc): fixed = solver_tol; ew = an inexact Newton, "
                                             "Eisenstat-Walker's forcing term (0.1 at most, no tighter than the "

@@ -127,6 +127,9 @@ def options(block: Cutting, scene, files) -> list[str]:
     raise ValueError("a [cutting] scene is run through wendel.cutting.fe (wendel run SCENE.toml), not as a block")
 
 
+FE_NUMERICS = {"direct", "newton_tol", "timeout"}      # the [numerics] keys wendel.cutting.fe.fe_scene passes on
+
+
 def check(block: Cutting, scene) -> None:
     """Rules joining [cutting] with [plasticity], [thermal] and [geometry], applied when the scene is read."""
     plast = getattr(scene, "plasticity", None)
@@ -144,6 +147,10 @@ def check(block: Cutting, scene) -> None:
         if not (k > 0 and c > 0):
             raise ValueError(f"cutting.fe_properties_T ({block.fe_properties_T:g} K) gives k = {k:g} W/m/K, "
                              f"c = {c:g} J/kg/K from thermal.k, thermal.c and the slopes: both must be > 0")
+    ignored = sorted(scene.numerics.model_fields_set - FE_NUMERICS)
+    if ignored:         # the FE cut's own numerics (wendel.cutting.fe.fe_scene): these would be read and not used
+        raise ValueError(f"numerics.{ignored[0]}: a cutting scene's FE cut takes only numerics.direct, "
+                         f"newton_tol and timeout (it solves with the direct solver on one rank, as fe_scene sets)")
     g = scene.geometry
     if g.builder == "orthogonal-cutting":
         uncut = (g.model_extra or {}).get("uncut")
