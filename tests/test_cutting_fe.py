@@ -133,13 +133,13 @@ def test_fe_cut_fbar_compiled_patch_term_is_the_freefem_one(tmp_path):
 
 @pytest.mark.parametrize("volumetric, heat, words", [
     ("fbar", "adiabatic", ['thermal.coupling = "staggered"', "r/3 to r/5", 'volumetric = "cell"']),
-    ("fbar", "staggered", ["cutting.edge_size r/3 or less", 'volumetric = "cell"']),
+    ("fbar", "staggered", ["another edge size (cutting.edge_size)", "r/4 stopped at 421 um", 'volumetric = "cell"']),
     ("fbar", "none", ["cutting.edge_size r/2 or more", 'volumetric = "cell"']),
     ("cell", "adiabatic", [])])
 def test_an_fbar_cut_that_tangles_stops_with_what_to_change(tmp_path, volumetric, heat, words):
     # The last step cut of a failing increment stops the run; when F-bar tangled the mesh the message says which
     # keys go on (README "What inverts the fine F-bar meshes"): heated adiabatically, conduction first; with
-    # conduction finer edge cells; without heat coarser ones; with the cells' own volume change nothing more.
+    # conduction another edge size; without heat coarser ones; with the cells' own volume change nothing more.
     from wendel import freefem
     from wendel.errors import StepCutError
     from wendel.loop.checkpoint import RunFiles, State

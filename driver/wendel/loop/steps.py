@@ -165,8 +165,8 @@ def _hint(scene: Scene, reason: str) -> str:
                        "meshes r/3 to r/5 cut through in wendel bench cutting-mesh. Or volumetric = \"cell\" (P1 "
                        "locks: stiffer, but it goes on)")
     if th is not None and th.beta > 0:
-        return text + (": with conduction the cut at an edge size of r/2 stopped where r/3 to r/5 ran through "
-                       "(wendel bench cutting-mesh): finer cells at the edge (cutting.edge_size r/3 or less), or "
-                       "volumetric = \"cell\" (P1 locks: stiffer, but it goes on)")
+        return text + (": with conduction the edge sizes r/2 to r/5 cut 400 um through (wendel bench cutting-mesh) "
+                       "and r/2 and r/3 1.2 mm, where r/4 stopped at 421 um (session 23): another edge size "
+                       "(cutting.edge_size), or volumetric = \"cell\" (P1 locks: stiffer, but it goes on)")
     return text + (": coarser cells there (at a cutting edge cutting.edge_size r/2 or more) or volumetric = "
                    "\"cell\" (P1 locks: stiffer, but it goes on)")
