@@ -96,6 +96,7 @@ def main(argv: list[str] | None = None) -> int:
                    "  cutting-steady-mesh (the F-bar cut with conduction to 1.2 mm at r/2, r/3, r/4: 1-3 h each),\n"
                    "  cutting-long (the FE cut to 2.4 mm, about 25 minutes),\n"
                    "  direct (UMFPACK64 against MUMPS on the cut, a 2D and a 3D scene, about 10 minutes),\n"
+                   "  cutting-levers (a 200 um F-bar cut with conduction as it is, again, and with 2 levers, 15 minutes),\n"
                    "  cutting-heat (the FE cut to 400 um adiabatic and with conduction, about 20 minutes),\n"
                    "  cutting-ti (the titanium FE cut on the graded mesh, about 10 minutes),\n"
                    "  cutting-kienzle (the FE Kienzle campaign: 8 cuts by wendel sweep, about 40 core minutes),\n"
