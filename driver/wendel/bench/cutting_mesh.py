@@ -4,8 +4,7 @@ The steel scene ``workflows/cutting-aisi1045.toml`` is cut with the graded remes
 :func:`wendel.cutting.fe.size_zones`) at three edge resolutions, the edge radius r = 20 um over 2, 3 and 4
 (10, 6.7 and 5 um at the edge, the rest of the mesh the same; at r/1, 20 um, the first re-equilibration did not
 converge, measured), and once more at r/2 with half the increment (2.5 um, remeshed every twice as many increments: the same 40 um of travel between remeshes).
-Each cuts the first 400 um (2.7 h) of the scene's 600 um (``STEPS``: the whole cut at r/4 took 25 minutes
-here); ``--quick`` the first 100 um.
+Each cuts the first 400 um (2.7 h) of the scene's 600 um (``STEPS``); ``--quick`` the first 100 um.
 
 A remeshed cut is a saw-tooth (the force drops in each re-equilibration and recovers over the cycle), so each
 case is measured over the same **window of travel**, the last ``WINDOW`` (160 um, 4 remesh cycles): ``*_last``
@@ -14,13 +13,11 @@ the work over the travel), ``*_spread`` the spread (max - min) / mean of the rem
 (:func:`wendel.cutting.fe_steady.cycle_means`) inside it, ``*_inc_spread`` that of the single increments. ``dFc_*`` compare the case with the finest
 edge at the same step and with the same edge at the other step: ``(F_c - F_c_ref) / F_c_ref``.
 
-``wendel bench cutting-steady``: the middle resolution cut 1.2 mm, twice the scene's length, on a longer block:
-the remesh-cycle means and whether they settle. ``wendel bench cutting-fbar``: the middle resolution with F-bar (``cutting.volumetric = "fbar"``), against
-the same case without it; ``wendel bench cutting-steady-fbar``: ``cutting-steady`` with F-bar.
+``cutting-steady``: r/2 cut 1.2 mm on a longer block: do the remesh-cycle means settle; ``cutting-fbar``: r/2 with F-bar
+(``cutting.volumetric = "fbar"``) against the same without it; ``cutting-steady-fbar``: ``cutting-steady`` with F-bar.
 
-Each case is written to ``results/bench/work/cutting-mesh/<case>/``; a case whose folder already holds the
-finished cut of the same scene (``cutting.csv`` and ``summary.json`` of that ``scene.resolved.json``) is read,
-not run again (the cases take 8-25 minutes each here): delete the folder to run it again."""
+Each case is written to ``results/bench/work/cutting-mesh/<case>/``; a folder holding the finished cut of the same
+scene (``cutting.csv``, ``summary.json``, that ``scene.resolved.json``) is read, not run again (8-25 minutes a case)."""
 
 from __future__ import annotations
 
@@ -194,7 +191,8 @@ def cutting_steady_bench(quick: bool, workdir: Path) -> list[dict]:
     400 um. ``WENDEL_BENCH_SNAP=1`` (also for ``cutting-steady-fbar`` and ``cutting-long``): with
     ``cutting.snap_to_tool`` (folder ``...-snap``); ``WENDEL_BENCH_CONDUCTION=1``: with heat conduction and
     frictional heat (``thermal.coupling = "staggered"``, as ``cutting-heat``; folder ``...-conduction``);
-    ``WENDEL_BENCH_EDGE``: the edge size r / that whole number (2-8; folder ``r<n>-...``) instead of r/2."""
+    ``WENDEL_BENCH_EDGE``: the edge size r / that whole number (2-8; folder ``r<n>-...``) instead of r/2;
+    ``WENDEL_BENCH_MUMPS=1``: MUMPS as the direct solver (``numerics.direct``; folder ``...-mumps``)."""
     return _steady(quick, workdir, "cell")
 
 
@@ -245,6 +243,8 @@ def _steady(quick: bool, workdir: Path, vol: str, remesh_every: int | None = Non
         scene.cutting.snap_to_tool, folder = True, folder + "-snap"
     if env_flag("WENDEL_BENCH_CONDUCTION", 'thermal.coupling = "staggered"'):
         scene.thermal.coupling, folder = "staggered", folder + "-conduction"
+    if env_flag("WENDEL_BENCH_MUMPS", 'numerics.direct = "mumps"'):
+        scene.numerics.direct, folder = "mumps", folder + "-mumps"
     long = length > 1.2e-3
     length = 0.4e-3 if quick else length
     scene.geometry.model_extra["length"] = block
