@@ -10,14 +10,14 @@ its last ``WINDOW`` of travel (300 um, 2 h; 20 remesh cycles at r/3, remeshed al
 :func:`wendel.bench.cutting_mesh.measure` (the means weighted by travel, the spread of the remesh-cycle means),
 with the drift of those cycle means over the window (:func:`wendel.cutting.fe_steady.window`'s ``*_trend``: a
 cut still settling drifts); ``dFc``, ``dFt``, ``dchip``: the change from the next coarser edge. ``--quick``: 400 um
-cuts in this bench's own folder, the last 100 um."""
+cuts in this bench's own folder, the last 100 um. ``WENDEL_BENCH_MUMPS=1``: the cuts with MUMPS (folders ``...-mumps``)."""
 
 from __future__ import annotations
 
 import csv
 from pathlib import Path
 
-from . import edges, environ, register
+from . import edges, env_flag, environ, register
 
 WINDOW = 300e-6     # m: the last 2 h of the 1.2 mm
 DEFAULT = [("r/2", 2, 1), ("r/4", 4, 1), ("r/3", 3, 1)]
@@ -36,8 +36,9 @@ def cutting_steady_mesh_bench(quick: bool, workdir: Path) -> list[dict]:
     for d in divs:
         with environ(WENDEL_BENCH_EDGE=str(d), WENDEL_BENCH_CONDUCTION="1", WENDEL_BENCH_SNAP="0"):
             last = _steady(quick, root, "fbar", reuse=True)[-1]
+        mumps = "-mumps" if env_flag("WENDEL_BENCH_MUMPS", 'numerics.direct = "mumps"') else ""
         cut = [{k: float(v) for k, v in r.items()}
-               for r in csv.DictReader((root / f"r{d}-long-conduction" / "cutting.csv").open())]
+               for r in csv.DictReader((root / f"r{d}-long-conduction{mumps}" / "cutting.csv").open())]
         w = window(cut, length)
         drift = {f"{n}_drift": w[f"steady_{k}_trend"] for n, k in (("Fc", "Fc_N"), ("Ft", "Ft_N"), ("chip", "chip_m"))}
         cost = {k: last[k] for k in ("increments", "step_cuts", "newton_iterations", "remeshes", "wall_s", "stopped")}
