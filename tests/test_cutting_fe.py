@@ -175,3 +175,19 @@ def test_the_cut_takes_the_scenes_newton_tolerance_and_1e_8_without_one(tmp_path
     scene.write_text(text + "\n[numerics]\nnewton_maxit = 50\n")     # read and not used: refused, by file and key
     with pytest.raises(SceneError, match=r"loose\.toml.*numerics\.newton_maxit.*only numerics\.direct, newton_tol"):
         load(scene)
+
+
+def test_a_resumed_report_reads_the_cutting_scene_as_run(tmp_path):
+    """A cut whose scene a bench or a script changed in memory (here the block's length) is reported after a
+    resume from the scene as run (cutting-scene.json), not from the file's: the same cutting.csv. Session 23: a
+    resumed r/4 bench cut was reported with the file's block and edge, its chip thickness NaN throughout."""
+    from wendel.cutting.fe_run import SCENE_JSON, report_resumed
+    cut = load(STEEL, smoke=True)
+    assert cut.geometry.model_extra["length"] != 1.2e-3
+    cut.geometry.model_extra["length"] = 1.2e-3
+    root = run_cut(cut, STEEL, tmp_path / "cut", smoke=True, progress=lambda *_: None, frames=False)
+    assert json.loads((root / SCENE_JSON).read_text())["geometry"]["length"] == 1.2e-3
+    before = (root / "cutting.csv").read_text()
+    (root / "cutting.csv").unlink()
+    report_resumed(root, progress=lambda *_: None)
+    assert (root / "cutting.csv").read_text() == before

@@ -41,6 +41,7 @@ from . import chip
 from .fe import MM, fe_scene, forces, tool_at_start
 
 STEADY_LENGTH = 1.0    # the steady-state window: one uncut chip thickness of travel (fe_steady)
+SCENE_JSON = "cutting-scene.json"      # the cutting scene as run (report_resumed)
 COLUMNS = ["increment", "load_factor", "tool_travel_m", "Fc_N", "Ft_N", "chip_rise_m", "contact_length_m",
            "chip_thickness_m", "shear_angle_deg", "max_plastic_strain", "max_temperature_K", "max_T_primary_K",
            "max_T_secondary_K", "heat_plastic_J", "heat_friction_chip_J", "heat_friction_tool_J", "heat_stored_J",
@@ -56,7 +57,8 @@ def run_cut(scene, scene_path: Path, out: Path, smoke: bool, progress=print, fra
     from ..scene import load
     travel = scene.loading.steps / load(scene_path).loading.steps if smoke else 1.0
     try:
-        root = Path(run_scene(fe_scene(scene, travel), scene_path, out, smoke, progress))
+        root = Path(run_scene(fe_scene(scene, travel), scene_path, out, smoke, progress,
+                              record={SCENE_JSON: as_set(scene)}))
     except Exception:
         root = Path(out).resolve()
         if (root / "history.csv").is_file():       # a cut that stops: its accepted increments are reported
@@ -76,9 +78,11 @@ def report_resumed(root: Path, progress=print) -> Path:
     folder's scene.toml is the cutting scene; the share of the cut (a smoke cut is its first increments) is read
     from the FE scene that was solved. Nothing for a run folder of any other scene. Returns ``root``."""
     from ..scene import SceneError, load
+    from ..scene.schema import Scene
     root = Path(root)
-    try:
-        scene = load(root / "scene.toml")
+    try:       # the cutting scene as run (a bench or a script may have changed the file's), else the file's
+        scene = Scene.model_validate_json((root / SCENE_JSON).read_text()) if (root / SCENE_JSON).is_file() \
+            else load(root / "scene.toml")
     except (SceneError, OSError, ValueError):
         return root
     if getattr(scene, "cutting", None) is None:
@@ -89,6 +93,20 @@ def report_resumed(root: Path, progress=print) -> Path:
     if rows:
         progress(f"  cut {rows[-1]['tool_travel_m'] * 1e3:.4g} mm: F_c = {rows[-1]['Fc_N']:.4g} N (cutting.csv, frames/)")
     return root
+
+
+def as_set(model) -> dict:
+    """The fields of a pydantic ``model`` that were read or assigned, nested (a sub-table changed in place
+    counts, though its own field was never assigned): the cutting scene as run, valid again as a scene."""
+    from pydantic import BaseModel
+    out = model.model_dump(mode="json", exclude_unset=True)
+    for name in type(model).model_fields:
+        value = getattr(model, name)
+        if isinstance(value, BaseModel):
+            sub = as_set(value)
+            if sub or name in out:
+                out[name] = sub
+    return out
 
 
 def _boundary_nodes(cells: np.ndarray) -> np.ndarray:

@@ -73,8 +73,8 @@ def run(scene_path: str | Path, smoke: bool = False, ranks: int | None = None, o
     return run_scene(scene, scene_path, Path(out) if out else _new_run_dir(scene_path, smoke), smoke, progress)
 
 
-def run_scene(scene: Scene, scene_path: Path, out: Path, smoke: bool = False, progress=print) -> Path:
-    """Run an already validated scene (read from ``scene_path``) into the folder ``out``."""
+def run_scene(scene: Scene, scene_path: Path, out: Path, smoke: bool = False, progress=print, record=None) -> Path:
+    """Run an already validated scene (read from ``scene_path``) into ``out`` (``record``: write_provenance's)."""
     files = RunFiles(Path(out).resolve())      # FreeFEM runs inside the run folder: paths must be absolute
     if files.root.is_dir() and any(files.root.iterdir()):
         # never mix a new run with the files of another (nor delete them): a new folder, or --resume
@@ -97,7 +97,7 @@ def run_scene(scene: Scene, scene_path: Path, out: Path, smoke: bool = False, pr
     with guarded(files.root):
         if scene.output.png:
             pictures.prestart()        # the renderer starts while the driver meshes (issue 20)
-        summary.write_provenance(files.root, Path(scene_path), scene, smoke)
+        summary.write_provenance(files.root, Path(scene_path), scene, smoke, record)
         state = State(pending=scene.loading.load_factors())
         state.mesh_seconds, dimension = build(scene, files)
         _save_checkpoint(files, scene, state, dimension)

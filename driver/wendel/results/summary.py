@@ -44,8 +44,9 @@ def _freefem_version() -> str:
         return "unknown"
 
 
-def write_provenance(root: Path, scene_path: Path, scene, smoke: bool) -> None:
-    """The scene as run and where it ran: commit, versions, command line, host, start time.
+def write_provenance(root: Path, scene_path: Path, scene, smoke: bool, record: dict | None = None) -> None:
+    """The scene as run and where it ran: commit, versions, command line, host, start time; ``record``: more JSON
+    files (name: data) beside scene.toml (the FE cut's cutting scene as run: wendel.cutting.fe_run.report_resumed).
 
     The commit and the package versions (two git and one dpkg-query process, seven package metadata parsed:
     0.17 s, a seventh of a smoke run, issue 20) are looked up in a thread while the run meshes and solves;
@@ -54,6 +55,8 @@ def write_provenance(root: Path, scene_path: Path, scene, smoke: bool) -> None:
     # first and atomically: a run stopped before its first checkpoint restarts from it (wendel run --resume)
     _write_json(root / "scene.resolved.json", scene.model_dump(mode="json"))
     shutil.copyfile(scene_path, root / "scene.toml")
+    for name, data in (record or {}).items():
+        _write_json(root / name, data)
     prov = {"command": sys.argv, "smoke": smoke, "host": socket.gethostname(), "platform": platform.platform(),
             "cpus": os.cpu_count(), "start": time.strftime("%Y-%m-%dT%H:%M:%S%z")}
     _write_json(root / "provenance.json", prov)
