@@ -46,6 +46,7 @@ import math
 import numpy as np
 
 from ..meshes.cutting import orthogonal_cutting
+from ..scene.blocks.cutting import FE_NUMERICS
 from ..scene.schema import Scene
 from .tool import tool_polygon
 
@@ -175,9 +176,9 @@ def fe_scene(scene, travel: float = 1.0) -> Scene:
         # predictor: each increment starts from the last one's motion extrapolated (the tool moves steadily; the
         # first guess from u_n met the tool 5 um deep: 30-40 % fewer Newton iterations, measured in session 8)
         # direct: the scene's factorization (numerics.direct = "mumps": MUMPS, faster on F-bar's denser matrix)
-        # newton_tol: 1e-8 unless the scene sets numerics.newton_tol; timeout: the scene's, per FreeFEM launch
-        "numerics": {"solver": "direct", "newton_tol": newton_tol(scene), "newton_maxit": 100,
-                     "predictor": "extrapolate", "direct": scene.numerics.direct, "timeout": scene.numerics.timeout},
+        # newton_tol 1e-8; the scene's numerics.direct, newton_tol and timeout where it sets them (FE_NUMERICS)
+        "numerics": {"solver": "direct", "newton_tol": 1e-8, "newton_maxit": 100, "predictor": "extrapolate",
+                     **scene.numerics.model_dump(include=FE_NUMERICS, exclude_unset=True)},
         "output": {"png": False, "vtu": True},
         "remesh": remesh,
     }
@@ -197,12 +198,6 @@ def fe_scene(scene, travel: float = 1.0) -> Scene:
             # is rigid and not meshed (it leaves the model: friction_heat_tool in record.json)
             friction["heat_fraction"] = c.heat_to_chip if c.frictional_heat is not False else 0.0
     return Scene.model_validate(data)
-
-
-def newton_tol(scene) -> float:
-    """The FE cut's relative Newton tolerance: ``numerics.newton_tol`` where the scene sets it, else 1e-8."""
-    n = scene.numerics
-    return n.newton_tol if "newton_tol" in n.model_fields_set else 1e-8
 
 
 def properties(scene) -> tuple[float, float]:
