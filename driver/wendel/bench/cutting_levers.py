@@ -17,9 +17,7 @@ import json
 import shutil
 from pathlib import Path
 
-import numpy as np
-
-from . import WORKFLOWS, register
+from . import register
 
 LEVERS = [("base", {}), ("base again", {}), ("newton_tol 1e-6", {"newton_tol": 1e-6}),
           ("remesh_every 16", {"remesh_every": 16})]
@@ -27,13 +25,10 @@ PHASES = ("assembly", "linear_solve", "constitutive", "failed_increments", "fail
 
 
 def _scene(steps: int, lever: dict):
-    from .cutting_mesh import _scene as steel
-    scene = steel(2, 1, quick=False, vol="fbar")
-    scene.thermal.coupling = "staggered"
+    from .direct import cut_scene
+    scene = cut_scene(steps)
     scene.numerics.direct = "mumps"
     scene.geometry.model_extra["length"] = 2.6e-3       # the settled-cut benches' block
-    scene.cutting.cut_length = steps * 5e-6
-    scene.loading.steps = steps
     if "newton_tol" in lever:
         scene.numerics.newton_tol = lever["newton_tol"]
     if "remesh_every" in lever:
@@ -42,39 +37,29 @@ def _scene(steps: int, lever: dict):
 
 
 def _run(name: str, lever: dict, steps: int, out: Path) -> dict:
-    from ..cutting.fe_run import run_cut
-    from ..errors import StepCutError
-    from ..freefem import FreeFemError, NewtonFailure
+    from .cutting_mesh import cut, measure
     shutil.rmtree(out, ignore_errors=True)
-    stopped = ""
-    try:
-        run_cut(_scene(steps, lever), WORKFLOWS / "cutting-aisi1045.toml", out, smoke=False,
-                progress=lambda *_: None, frames=False)
-    except (NewtonFailure, StepCutError, FreeFemError) as exc:
-        stopped = str(exc).split(";")[0]
+    stopped = cut(_scene(steps, lever), out, frames=False)
     s = json.loads((out / "summary.json").read_text())
     rows = [{k: float(v) for k, v in r.items()} for r in csv.DictReader((out / "cutting.csv").open())]
-    t = np.array([r["tool_travel_m"] for r in rows])
-    w = np.diff(t, prepend=0.0)
-    last = (t > t[-1] - 100e-6 + 1e-12) & (w > 1e-12)
+    last = measure(rows, 100e-6)        # travel-weighted means over the last 100 um
     ph = s["wall_time_by_phase"]
-    return {"case": name, "travel_um": t[-1] * 1e6, "increments": s["increments"], "step_cuts": s["step_cuts"],
-            "newton_iterations": s["newton_iterations"], "remeshes": len(s["remeshes"]), "wall_s": s["wall_time"],
-            **{f"{p}_s": ph.get(p, 0.0) for p in PHASES},
-            "Fc_last100": float(np.average([r["Fc_N"] for r, k in zip(rows, last) if k], weights=w[last])),
-            "Ft_last100": float(np.average([r["Ft_N"] for r, k in zip(rows, last) if k], weights=w[last])),
-            "stopped": stopped}
+    return {"case": name, "travel_um": rows[-1]["tool_travel_m"] * 1e6, "increments": s["increments"],
+            "step_cuts": s["step_cuts"], "newton_iterations": s["newton_iterations"], "remeshes": len(s["remeshes"]),
+            "wall_s": s["wall_time"], **{f"{p}_s": ph.get(p, 0.0) for p in PHASES},
+            "Fc_last100": last["Fc_last"], "Ft_last100": last["Ft_last"], "stopped": stopped}
 
 
 @register("cutting-levers")
 def cutting_levers_bench(quick: bool, workdir: Path) -> list[dict]:
     """The 200 um F-bar cut with conduction as the scene says, again, and with each lever (see the module)."""
     steps = 8 if quick else 40
-    rows = []
+    rows, base = [], None
     for name, lever in LEVERS[2:] if quick else LEVERS:
         out = workdir / name.replace(" ", "-")
         rows.append(_run(name, lever, steps, out))
-        base = workdir / "base" / "cutting.csv"
-        if base.is_file():
-            rows[-1]["same_as_base"] = (out / "cutting.csv").read_bytes() == base.read_bytes()
+        got = (out / "cutting.csv").read_bytes()
+        base = got if name == "base" else base          # this run's base only (not an older run's folder)
+        if base is not None:
+            rows[-1]["same_as_base"] = got == base
     return rows

@@ -112,12 +112,21 @@ def sawtooth(out: Path) -> dict:
             "mean_stress_abs_after_max": max(after)}
 
 
-def _case(name: str, divide: int, substeps: int, quick: bool, workdir: Path, vol: str | None = None) -> dict:
-    import csv
-
+def cut(scene, out: Path, frames: bool) -> str:
+    """The steel scene's FE cut ``scene`` into ``out``; why it stopped (its message to the first ";"), "" if it ran
+    through. Its accepted increments are reported either way (``cutting.csv``)."""
     from ..cutting.fe_run import run_cut
     from ..errors import StepCutError
     from ..freefem import FreeFemError, NewtonFailure
+    try:
+        run_cut(scene, WORKFLOWS / "cutting-aisi1045.toml", out, smoke=False, progress=lambda *_: None, frames=frames)
+    except (NewtonFailure, StepCutError, FreeFemError) as exc:
+        return str(exc).split(";")[0]
+    return ""
+
+
+def _case(name: str, divide: int, substeps: int, quick: bool, workdir: Path, vol: str | None = None) -> dict:
+    import csv
 
     scene = _scene(divide, substeps, quick, vol)
     name += heat(scene)         # WENDEL_BENCH_HEAT
@@ -129,11 +138,7 @@ def _case(name: str, divide: int, substeps: int, quick: bool, workdir: Path, vol
     else:
         shutil.rmtree(out, ignore_errors=True)
         t0 = time.perf_counter()
-        try:
-            run_cut(scene, WORKFLOWS / "cutting-aisi1045.toml", out, smoke=False, progress=lambda *_: None,
-                    frames=False)
-        except (NewtonFailure, StepCutError, FreeFemError) as exc:
-            stopped = str(exc).split(";")[0]
+        stopped = cut(scene, out, frames=False)
         wall = time.perf_counter() - t0
         (out / "bench-case.json").write_text(json.dumps({"wall_s": wall, "stopped": stopped}))
     if (out / "bench-case.json").is_file():
@@ -258,15 +263,8 @@ def _steady(quick: bool, workdir: Path, vol: str, remesh_every: int | None = Non
         raise RuntimeError(f"{out} holds an unfinished cut (running elsewhere?): let it finish, or delete the folder")
     if not reuse:                                   # (with reuse there is nothing to delete by now)
         shutil.rmtree(out, ignore_errors=True)
-    from ..cutting.fe_run import run_cut
-    from ..errors import StepCutError
-    from ..freefem import FreeFemError, NewtonFailure
-    stopped, t0 = "", time.perf_counter()
-    try:
-        if not reused:
-            run_cut(scene, WORKFLOWS / "cutting-aisi1045.toml", out, smoke=False, progress=lambda *_: None, frames=True)
-    except (NewtonFailure, StepCutError, FreeFemError) as exc:
-        stopped = str(exc).split(";")[0]
+    t0 = time.perf_counter()
+    stopped = "" if reused else cut(scene, out, frames=True)
     rows = [{k: float(v) for k, v in r.items()} for r in csv.DictReader((out / "cutting.csv").open())]
     s = json.loads((out / "summary.json").read_text()) if (out / "summary.json").is_file() else {}
     wall = s.get("wall_time", float("nan")) if reused else time.perf_counter() - t0

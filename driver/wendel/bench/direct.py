@@ -26,11 +26,12 @@ from . import WORKFLOWS, register
 LIBS = ("umfpack", "mumps")
 
 
-def _cut(quick: bool):
+def cut_scene(steps: int):
+    """The steel cut's first ``steps`` increments of 5 um at edge r/2 with F-bar and conduction (also
+    ``cutting-levers``'s)."""
     from .cutting_mesh import _scene
     scene = _scene(2, 1, quick=False, vol="fbar")
     scene.thermal.coupling = "staggered"
-    steps = 8 if quick else 24
     scene.cutting.cut_length = steps * 5e-6
     scene.loading.steps = steps
     return scene
@@ -41,7 +42,7 @@ def _run(name: str, lib: str, quick: bool, out: Path) -> dict:
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     if name == "cut":
         from ..cutting.fe_run import run_cut
-        scene = _cut(quick)
+        scene = cut_scene(8 if quick else 24)
         scene.numerics.direct = lib
         root = run_cut(scene, WORKFLOWS / "cutting-aisi1045.toml", out, smoke=False, progress=lambda *_: None,
                        frames=False)
