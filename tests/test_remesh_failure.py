@@ -18,19 +18,22 @@ from wendel.errors import StepCutError
 from wendel.loop.checkpoint import RunFiles, State
 from wendel.loop.steps import RELAX_MAX, cut_step
 from wendel.remesh.again import AGAIN
+from wendel.remesh.batch import first_steps
 from wendel.scene import load
 
 from conftest import WORKFLOWS
 
 
-def _reequilibrating(after_failed_step: bool, inverted: int, quality: float = 0.11, volumetric: str = "cell"):
+def _reequilibrating(after_failed_step: bool, inverted: int, quality: float = 0.11, volumetric: str = "cell",
+                     first: list | None = None):
     cut = load(WORKFLOWS / "cutting-aisi1045.toml", smoke=True)
     cut.cutting.volumetric = volumetric
     scene = fe_scene(cut)
     rep = {"remesh": 2, "after_increment": 9, "relax_steps": RELAX_MAX, "algorithm_2d_tries": len(AGAIN),
            "dimension": 2, "min_quality_before": quality, "inverted_before": inverted,
-           "after_failed_step": after_failed_step}
-    state = State(accepted=[(9, 0.5)], pending=[0.5, 0.55, 0.6], remeshes=[rep], reequilibrate=True)
+           "after_failed_step": after_failed_step, "first_steps": first or []}
+    state = State(accepted=[(9, 0.5)], pending=[0.5] + (first or []) + [0.55, 0.6], remeshes=[rep],
+                  reequilibrate=True)
     state.segments.append({"first": 10, "mesh": "meshes/mesh-2.msh", "ubase": None, "eps0": None,
                            "state": "remesh/state-2"})
     failure = freefem.NewtonFailure({"increment": 10, "load_factor": 0.5, "reason": "mesh would invert"})
@@ -46,6 +49,26 @@ def test_a_scheduled_remesh_that_cannot_be_reequilibrated_is_dropped_and_the_old
     kept = json.loads((tmp_path / "failed-attempts" / "remesh-2-after-9.json").read_text())
     assert kept["algorithm_2d_tries"] == len(AGAIN)
     assert "going on with the mesh before it (min quality 0.11)" in said[-1]
+
+
+def test_the_first_steps_on_a_new_mesh_are_a_share_of_the_step_and_leave_with_a_dropped_remesh(tmp_path):
+    # the F-bar cut's remeshes put 1/4 and 1/2 of the next step before it (remesh.first_step = 0.25), and its
+    # schedule of remeshes counts them (every 8 steps: after increments 8, 8 + 11, ...), the P1 cut's not (its
+    # whole steps go); a remesh dropped takes them out
+    cut = load(WORKFLOWS / "cutting-aisi1045.toml")
+    cut.cutting.remesh_every = 8
+    scene = fe_scene(cut)
+    assert scene.remesh.first_step == 1 and scene.remesh.at[:3] == [8, 17, 26]
+    assert first_steps(scene, 0.5, [0.55, 0.6]) == []
+    cut.cutting.volumetric = "fbar"
+    scene = fe_scene(cut)
+    assert scene.remesh.first_step == 0.25 and scene.remesh.at[:3] == [8, 19, 30]
+    assert first_steps(scene, 0.5, [0.55, 0.6]) == pytest.approx([0.5125, 0.525])
+    scene.loading.adaptive = True           # adaptive loading plans its own steps
+    assert first_steps(scene, 0.5, [0.55, 0.6]) == []
+    scene, state, failure = _reequilibrating(False, 0, first=[0.5125, 0.525])
+    cut_step(scene, RunFiles(tmp_path), state, failure, lambda *_: None)
+    assert not state.reequilibrate and state.pending == [0.55, 0.6]
 
 
 def test_fbar_reequilibrates_once_with_the_cells_own_volume_change_before_it_drops_the_remesh(tmp_path):

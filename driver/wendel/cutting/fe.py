@@ -46,6 +46,7 @@ import math
 import numpy as np
 
 from ..meshes.cutting import orthogonal_cutting
+from ..remesh.batch import ramp
 from ..scene.blocks.cutting import FE_NUMERICS
 from ..scene.schema import Scene
 from .tool import tool_polygon
@@ -54,6 +55,10 @@ MM = 1e3          # m -> mm
 MPA = 1e-6        # Pa -> MPa
 GAP = 0.02        # the tool starts this fraction of h in front of the step face
 RELAX_STEPS = 4   # the re-equilibration after a remesh releases the transferred out-of-balance in 4 stages
+# F-bar's first forward step on a new mesh: 1/4, 1/4, 1/2 of the step (cutting.first_step; session 24: on the 1.2 mm
+# r/2 cut with conduction it converged at 1/16 (7 of 51 remeshes), 1/8 (19), 1/4 (20) or 1/2 (5) of the step after
+# 1-4 failed tries; the P1 cells' cut takes its whole steps there: 17 increments, 31 with this, on the smoke cut)
+FIRST_STEP_FBAR = 0.25
 # F-bar's chip front folds where it meets the uncut surface ahead (notches 3-5 um deep, 0.4 mm ahead of the tool):
 # its remeshes drop boundary nodes standing less than a quarter of the new size off their neighbours' chord (fresh
 # meshes' minimum quality 0.57-0.65 instead of 0.08-0.16 from 665 um on, measured; remesh.smooth_features)
@@ -131,14 +136,17 @@ def fe_scene(scene, travel: float = 1.0) -> Scene:
         friction["tau_max"] = c.shear_cap * MPA
     steps = scene.loading.steps
     every = c.remesh_every
-    # the re-equilibration after a remesh is an increment too: the k-th remesh follows increment k (every + 1) - 1
-    # (a step cut shifts the later ones by one increment, and adds one: the list runs on to 3 times the steps, or
-    # a cut with many step cuts ran out of scheduled remeshes at 70 % of its travel, measured at edge size r/4)
-    at = [k * (every + 1) - 1 for k in range(1, 3 * steps // every + 1)] if every else []
+    # the re-equilibration after a remesh is an increment too, and so are the first steps' shares (first): the
+    # k-th remesh follows increment every + (k - 1) (every + 1 + n) (a step cut shifts the later ones by one
+    # increment, and adds one: the list runs on to 3 times the steps, or a cut with many step cuts ran out of
+    # scheduled remeshes at 70 % of its travel, measured at edge size r/4)
+    first = c.first_step or (FIRST_STEP_FBAR if c.volumetric == "fbar" else 1.0)
+    n = len(ramp(first))
+    at = [every + (k - 1) * (every + 1 + n) for k in range(1, 3 * steps // every + 1)] if every else []
     # uniform size fine * h (graded on p down to half of it at the edge, the isothermal cut stopped at 40 um
     # instead of 92.5, measured: "mesh would invert" after the second remesh)
     remesh = {"at": at, "indicator": "", "h": fine * g.h * MM, "max_remeshes": len(at) + 20,
-              "relax_steps": RELAX_STEPS}
+              "relax_steps": RELAX_STEPS, "relax_tol": c.relax_tol, "first_step": first}
     smooth = c.smooth_features if c.smooth_features is not None else (SMOOTH_FBAR if c.volumetric == "fbar" else 0.0)
     if smooth > 0:
         remesh["smooth_features"] = smooth

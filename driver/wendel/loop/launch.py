@@ -74,6 +74,8 @@ def options(scene: Scene, files: RunFiles, dimension: int, segment: dict | None 
         opts += ["-solver_forcing", n.forcing]
     if n.predictor == "extrapolate":
         opts += ["-newton_predictor", "1"]     # edp/lib/predictor.idp
+    if scene.remesh and scene.remesh.relax_tol:        # read by a re-equilibration's launch (-relax_steps)
+        opts += ["-relax_tol", repr(scene.remesh.relax_tol)]
     if n.solver == "petsc":
         opts += petsc.launch_options(n.petsc.pc, n.petsc.options, n.petsc.reuse)
     if scene.problem != "mechanics":

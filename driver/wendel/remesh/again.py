@@ -32,7 +32,7 @@ def drop_last_remesh(state) -> dict:
     factor): the loop stands after the increment it was made from, on the mesh before it. Its report."""
     rep = state.remeshes.pop()
     state.segments.pop()
-    state.pending.pop(0)
+    del state.pending[:1 + len(rep.get("first_steps", []))]
     state.reequilibrate = False
     return rep
 

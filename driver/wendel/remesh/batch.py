@@ -25,6 +25,29 @@ def inside_freefem(scene, dimension: int) -> bool:
     return dimension == 2 and scene.numerics.ranks == 1 and ELEMENT == "P1"
 
 
+def first_steps(scene, lf: float, pending: list[float]) -> list[float]:
+    """The load factors a remesh puts before the next one, after its re-equilibration at ``lf``
+    (``remesh.first_step`` f < 1: lf + f d, lf + 2 f d, ... below lf + d, d the step to ``pending[0]``). Measured on
+    the FE cut (README, session 24): the first forward step on a new mesh converged at 1/16-1/2 of the step, never
+    whole, after one to four failed tries."""
+    if not pending or scene.loading.adaptive:
+        return []
+    return [lf + s * (pending[0] - lf) for s in ramp(scene.remesh.first_step)]
+
+
+def ramp(f: float) -> list[float]:
+    """The shares of a step that :func:`first_steps` takes before the whole: f, 2 f, 4 f, ... below 1.
+
+    >>> ramp(0.25), ramp(0.3), ramp(1.0)
+    ([0.25, 0.5], [0.3, 0.6], [])
+    """
+    out = []
+    while f < 1 - 1e-9:
+        out.append(f)
+        f *= 2
+    return out
+
+
 def plan(scene, state, dimension: int) -> tuple[list[float], list[str]]:
     """The load factors of the next launch and its extra FreeFEM arguments.
 

@@ -14,9 +14,9 @@ it is too poor (or the scene asks for a remesh at that increment), gmsh meshes t
   volume-weighted average (which keeps their integral), interpolated and averaged on the new cells;
   other state files (``*.txt``) are copied.
 
-The driver then re-equilibrates at the same load factor before the next increment; the transfer
-report (``remesh/remesh-K.json``) records the residual before and after, the change of the integral
-and extrema of p, the quality before and after, and the times.
+The driver then re-equilibrates at the same load factor before the next increment; the transfer report
+(``remesh/remesh-K.json``) records the residual before and after, the change of the integral and extrema of p,
+the quality before and after, and the times.
 """
 
 from __future__ import annotations
@@ -32,6 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from .again import AGAIN, made_or_failed
+from .batch import first_steps
 from .snap import onto_tool, tool_at, zones_at       # the tool where it stands at a remesh (numpy only)
 from . import quality       # mesher (meshio, gmsh) and transfer (scipy) when a run remeshes: a run without
                             # remeshing judges its mesh only and does not pay their imports
@@ -247,9 +248,9 @@ def finish_report(report: dict, reeq_dir: Path, path: Path) -> dict:
     report["residual_after_reequilibration"] = float(rows[-1][col])
     report["reequilibration_iterations"] = len(rows) - 1
     rec = json.loads((reeq_dir / "record.json").read_text())
-    for key in ("contact_force", "contact_active_nodes", "max_plastic_strain", "plastic_points"):
-        if key in rec:
-            report[f"{key}_after"] = rec[key]
+    after = ("contact_force", "contact_active_nodes", "max_plastic_strain", "plastic_points")
+    report.update({f"{key}_after": rec[key] for key in after if key in rec})
+    report.update({k: rec[k] for k in ("relax_handovers", "relax_handover_residual") if k in rec})      # stages
     path.parent.mkdir(exist_ok=True)
     path.write_text(json.dumps(report, indent=1))
     return report
@@ -290,9 +291,10 @@ def maybe_remesh(scene, files, state, dimension: int, progress, again: int = 0, 
         algorithm_2d=AGAIN[again - 1] if again else None, smooth_features=r.smooth_features,
         tool=tool_at(scene, files.fem / f"inc-{inc:04d}") if r.snap_to_tool else None), k, inc, lf, q, files.root)
     rep.update({"remesh": k, "after_increment": inc, "load_factor": lf, "dimension": dimension,
-                "algorithm_2d_tries": again, "after_failed_step": failed})
+                "algorithm_2d_tries": again, "after_failed_step": failed,
+                "first_steps": first_steps(scene, lf, state.pending)})      # (drop_last_remesh takes them out)
     state.remeshes.append(rep)
     state.segments.append({"first": inc + 1, "mesh": mesh_new, "ubase": f"{state_dir}/ubase.txt",
                            "eps0": f"{state_dir}/eps0.txt", "state": state_dir})
-    state.pending.insert(0, lf)
+    state.pending[:0] = [lf] + rep["first_steps"]
     state.reequilibrate = True

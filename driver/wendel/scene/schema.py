@@ -299,6 +299,13 @@ class Remesh(Strict):
     relax_steps: int = Field(1, ge=1, le=64, description="the re-equilibration after a remesh releases the "
                              "transferred state's out-of-balance forces in this many stages, each converged by "
                              "Newton (1: at once) [1]")
+    relax_tol: Optional[float] = Field(None, gt=0, lt=1, description="relative residual at which a stage of the "
+                                       "re-equilibration before the last hands on to the next, whatever the contact "
+                                       "and friction sets do (the last stage converges as every increment) [1]; "
+                                       "default numerics.newton_tol: each stage converged")
+    first_step: float = Field(1.0, gt=0, le=1, description="the first forward step after a re-equilibration as a "
+                              "share of the step to the next load factor, doubled up to it (0.25: 1/4, 1/4, 1/2 of "
+                              "the step) [1]; 1: the whole step")
     zones: list[RemeshZone] = Field(default_factory=list, description="boxes of finer size [[remesh.zones]] "
                                     "(box, h, thickness), graded to remesh.h outside them")
     smooth_features: float = Field(0.0, ge=0, lt=0.5, description="2D: before meshing, drop old boundary nodes "

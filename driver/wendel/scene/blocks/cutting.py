@@ -103,6 +103,13 @@ class Cutting(BaseModel):
                                              "[1]; default 0.25 with volumetric = fbar (its chip front folds into "
                                              "notches a few um deep: fresh meshes of quality 0.09, measured), 0 "
                                              "(none) with cell")
+    relax_tol: float = Field(1e-2, gt=0, lt=1, description="FE: a stage of the re-equilibration after a remesh "
+                             "but the last hands on to the next at this relative residual, as remesh.relax_tol [1] "
+                             "(numerics.newton_tol or less: each stage converged, as before session 24)")
+    first_step: Optional[float] = Field(None, gt=0, le=1, description="FE: the first forward step after a remesh as "
+                                        "a share of the step, doubled up to it, as remesh.first_step [1]; default "
+                                        "0.25 with volumetric = fbar (it converged at 1/16-1/2 of the step after "
+                                        "failed tries, measured), 1 (the whole step) with cell")
     snap_to_tool: bool = Field(False, description="FE: the remeshes move new boundary nodes that fall inside the "
                                "tool (on old edges of the machined surface that cut its rounded edge: 1.3-3.4 um "
                                "deep on the F-bar steel cut, measured) onto its surface, as remesh.snap_to_tool")
