@@ -5,10 +5,15 @@ MUMPS (the settled-cut benches' scene, ``direct``'s cut made longer), as the sce
 (``base again``: the loop is deterministic, its ``cutting.csv`` the same byte for byte), and once per lever:
 ``numerics.newton_tol = 1e-6`` (the cut's own is 1e-8; below about 1e-4 its Newton iterations converge linearly,
 the heat and the Johnson-Cook softening being outside the tangent) and ``cutting.remesh_every = 16`` (half the
-re-equilibrations). Rows: increments, step cuts, Newton iterations, remeshes, wall time and its phases (assembly,
-linear solve, constitutive update, failed increments and failed launches, from ``summary.json``), the travel
-reached and why a run stopped, the travel-weighted F_c and F_t over the last 100 um, and ``same_as_base``.
-``--quick``: 40 um, the levers only."""
+re-equilibrations); session 24's two levers taken back one at a time and together (``cutting.relax_tol = 1e-8``:
+each stage of a re-equilibration converged; ``cutting.first_step = 1``: the whole first step on a new mesh), and,
+as a diagnostic, the cut without heat (``thermal.beta = 0``, adiabatic: no plastic or frictional heat). Rows:
+increments, step cuts, Newton iterations (of the increments accepted, of the re-equilibrations among them, and of
+the failed tries), remeshes, wall time and its phases (assembly, linear solve, constitutive update, failed
+increments and failed launches, from ``summary.json``), the median ratio of successive relative residuals below
+1e-3 (``tail_ratio``: about 0.1 is a linear tail, 1e-3 and less quadratic), the travel reached and why a run
+stopped, the travel-weighted F_c and F_t over the last 100 um, and ``same_as_base``. ``--quick``: 40 um, the
+levers only."""
 
 from __future__ import annotations
 
@@ -20,7 +25,9 @@ from pathlib import Path
 from . import register
 
 LEVERS = [("base", {}), ("base again", {}), ("newton_tol 1e-6", {"newton_tol": 1e-6}),
-          ("remesh_every 16", {"remesh_every": 16})]
+          ("remesh_every 16", {"remesh_every": 16}), ("stages converged", {"relax_tol": 1e-8}),
+          ("whole first step", {"first_step": 1.0}), ("before session 24", {"relax_tol": 1e-8, "first_step": 1.0}),
+          ("no heat", {"heat": False})]
 PHASES = ("assembly", "linear_solve", "constitutive", "failed_increments", "failed_launches")
 
 
@@ -31,9 +38,27 @@ def _scene(steps: int, lever: dict):
     scene.geometry.model_extra["length"] = 2.6e-3       # the settled-cut benches' block
     if "newton_tol" in lever:
         scene.numerics.newton_tol = lever["newton_tol"]
-    if "remesh_every" in lever:
-        scene.cutting.remesh_every = lever["remesh_every"]
+    for key in ("remesh_every", "relax_tol", "first_step"):
+        if key in lever:
+            setattr(scene.cutting, key, lever[key])
+    if "perturb" in lever:          # another round-off of the tool path (cutting-paths)
+        scene.cutting.cut_length *= 1 + lever["perturb"] * 1e-13
+    if lever.get("heat") is False:
+        scene.thermal.beta, scene.thermal.coupling = 0.0, "adiabatic"
     return scene
+
+
+def _newton(out: Path) -> dict:
+    """Newton iterations of the failed tries and of the re-equilibrations, and the tail ratio (see the module)."""
+    import numpy as np
+    failed = sum(len(f.read_text().splitlines()) - 2 for f in (out / "failed-attempts").glob("*-newton.csv"))
+    reeq = sum(json.loads(f.read_text()).get("reequilibration_iterations", 0) for f in (out / "remesh").glob("*.json"))
+    runs: dict = {}
+    for r in csv.DictReader((out / "newton.csv").open()):
+        runs.setdefault((r["increment"], r["load_factor"]), []).append(float(r["relative_residual"]))
+    ratios = [b / a for v in runs.values() for a, b in zip(v[1:], v[2:]) if 0 < a < 1e-3 and 0 < b]
+    return {"reequilibration_newton": reeq, "failed_newton": failed,
+            "tail_ratio": float(np.median(ratios)) if ratios else float("nan")}
 
 
 def _run(name: str, lever: dict, steps: int, out: Path) -> dict:
@@ -45,7 +70,8 @@ def _run(name: str, lever: dict, steps: int, out: Path) -> dict:
     last = measure(rows, 100e-6)        # travel-weighted means over the last 100 um
     ph = s["wall_time_by_phase"]
     return {"case": name, "travel_um": rows[-1]["tool_travel_m"] * 1e6, "increments": s["increments"],
-            "step_cuts": s["step_cuts"], "newton_iterations": s["newton_iterations"], "remeshes": len(s["remeshes"]),
+            "step_cuts": s["step_cuts"], "newton_iterations": s["newton_iterations"], **_newton(out),
+            "remeshes": len(s["remeshes"]),
             "wall_s": s["wall_time"], **{f"{p}_s": ph.get(p, 0.0) for p in PHASES},
             "Fc_last100": last["Fc_last"], "Ft_last100": last["Ft_last"], "stopped": stopped}
 
@@ -62,4 +88,22 @@ def cutting_levers_bench(quick: bool, workdir: Path) -> list[dict]:
         base = got if name == "base" else base          # this run's base only (not an older run's folder)
         if base is not None:
             rows[-1]["same_as_base"] = got == base
+    return rows
+
+
+@register("cutting-paths")
+def cutting_paths_bench(quick: bool, workdir: Path) -> list[dict]:
+    """The 200 um cut of ``cutting-levers`` as the scene says (``new``) and as before session 24 (``before``:
+    ``cutting.relax_tol = 1e-8``, ``cutting.first_step = 1``) on ``WENDEL_BENCH_PATHS`` (default 4) tool paths that
+    differ in their 13th digit (``cutting.cut_length`` times 1 + k 1e-13, k = 1, 2, ...): the cut's Newton path is
+    chaotic (a path that differed in its last digit took 117 step cuts instead of 190 over 1.2 mm), so a lever
+    is judged over several paths, new and before interleaved. ``--quick``: 2 paths of 40 um."""
+    import os
+    n = os.environ.get("WENDEL_BENCH_PATHS", "4")
+    if not (n.isdigit() and 1 <= int(n) <= 20):
+        raise ValueError(f"WENDEL_BENCH_PATHS = {n!r}: a whole number of paths from 1 to 20")
+    steps, rows = (8, []) if quick else (40, [])
+    for k in range(1, (2 if quick else int(n)) + 1):
+        for name, lever in (("new", {}), ("before", {"relax_tol": 1e-8, "first_step": 1.0})):
+            rows.append({"path": k, **_run(name, {**lever, "perturb": k}, steps, workdir / f"{name}-{k}")})
     return rows
