@@ -24,10 +24,10 @@ from pathlib import Path
 
 from . import register
 
+BEFORE_24 = {"relax_tol": 1e-8, "first_step": 1.0}     # the loop before session 24's two levers
 LEVERS = [("base", {}), ("base again", {}), ("newton_tol 1e-6", {"newton_tol": 1e-6}),
           ("remesh_every 16", {"remesh_every": 16}), ("stages converged", {"relax_tol": 1e-8}),
-          ("whole first step", {"first_step": 1.0}), ("before session 24", {"relax_tol": 1e-8, "first_step": 1.0}),
-          ("no heat", {"heat": False})]
+          ("whole first step", {"first_step": 1.0}), ("before session 24", BEFORE_24), ("no heat", {"heat": False})]
 PHASES = ("assembly", "linear_solve", "constitutive", "failed_increments", "failed_launches")
 
 
@@ -48,11 +48,12 @@ def _scene(steps: int, lever: dict):
     return scene
 
 
-def _newton(out: Path) -> dict:
-    """Newton iterations of the failed tries and of the re-equilibrations, and the tail ratio (see the module)."""
+def _newton(out: Path, summary: dict) -> dict:
+    """Newton iterations of the failed tries and of the re-equilibrations (the remesh reports in ``summary``), and
+    the tail ratio (see the module)."""
     import numpy as np
     failed = sum(len(f.read_text().splitlines()) - 2 for f in (out / "failed-attempts").glob("*-newton.csv"))
-    reeq = sum(json.loads(f.read_text()).get("reequilibration_iterations", 0) for f in (out / "remesh").glob("*.json"))
+    reeq = sum(r.get("reequilibration_iterations", 0) for r in summary["remeshes"])
     runs: dict = {}
     for r in csv.DictReader((out / "newton.csv").open()):
         runs.setdefault((r["increment"], r["load_factor"]), []).append(float(r["relative_residual"]))
@@ -70,7 +71,7 @@ def _run(name: str, lever: dict, steps: int, out: Path) -> dict:
     last = measure(rows, 100e-6)        # travel-weighted means over the last 100 um
     ph = s["wall_time_by_phase"]
     return {"case": name, "travel_um": rows[-1]["tool_travel_m"] * 1e6, "increments": s["increments"],
-            "step_cuts": s["step_cuts"], "newton_iterations": s["newton_iterations"], **_newton(out),
+            "step_cuts": s["step_cuts"], "newton_iterations": s["newton_iterations"], **_newton(out, s),
             "remeshes": len(s["remeshes"]),
             "wall_s": s["wall_time"], **{f"{p}_s": ph.get(p, 0.0) for p in PHASES},
             "Fc_last100": last["Fc_last"], "Ft_last100": last["Ft_last"], "stopped": stopped}
@@ -97,13 +98,14 @@ def cutting_paths_bench(quick: bool, workdir: Path) -> list[dict]:
     ``cutting.relax_tol = 1e-8``, ``cutting.first_step = 1``) on ``WENDEL_BENCH_PATHS`` (default 4) tool paths that
     differ in their 13th digit (``cutting.cut_length`` times 1 + k 1e-13, k = 1, 2, ...): the cut's Newton path is
     chaotic (a path that differed in its last digit took 117 step cuts instead of 190 over 1.2 mm), so a lever
-    is judged over several paths, new and before interleaved. ``--quick``: 2 paths of 40 um."""
+    is judged over several paths, new and before interleaved. ``--quick``: 2 paths of 40 um (no remesh in them: a
+    check of the bench, not of the levers)."""
     import os
     n = os.environ.get("WENDEL_BENCH_PATHS", "4")
     if not (n.isdigit() and 1 <= int(n) <= 20):
         raise ValueError(f"WENDEL_BENCH_PATHS = {n!r}: a whole number of paths from 1 to 20")
-    steps, rows = (8, []) if quick else (40, [])
+    steps, rows = 8 if quick else 40, []
     for k in range(1, (2 if quick else int(n)) + 1):
-        for name, lever in (("new", {}), ("before", {"relax_tol": 1e-8, "first_step": 1.0})):
+        for name, lever in (("new", {}), ("before", BEFORE_24)):
             rows.append({"path": k, **_run(name, {**lever, "perturb": k}, steps, workdir / f"{name}-{k}")})
     return rows
