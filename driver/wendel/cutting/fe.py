@@ -197,7 +197,8 @@ def fe_scene(scene, travel: float = 1.0) -> Scene:
         # on the current body (kinematics-thermal.idp), every boundary insulated unless [thermal.boundary] says
         # otherwise (the heat of a 0.1-0.2 ms cut diffuses sqrt(a t) ~ 40-60 um, the block is 0.5 mm deep)
         data["thermal"] = {"k": k, "rho": th.rho * 1e-6, "c": cap, "alpha": 0.0, "T_ref": th.T_ref,
-                           "beta": th.beta, "coupling": th.coupling, "duration": plasticity["load_time"]}
+                           "beta": th.beta, "coupling": th.coupling, "duration": plasticity["load_time"],
+                           "staggered_softening": th.staggered_softening}
         if th.T_initial is not None:
             data["thermal"]["T_initial"] = th.T_initial
         if th.coupling != "adiabatic":

@@ -89,6 +89,7 @@ class Thermal(BaseModel):
     tool_temperature: Optional[float] = Field(None, gt=0, description="temperature of the contact tool [K]; default T_ref")
     contact_conductance: float = Field(0.0, ge=0, description="heat transfer coefficient through the active contact zone [W/m^2/K]")
     moving_source: Optional[MovingSource] = Field(None, description="a heat source moving at constant velocity ([thermal.moving_source])")
+    staggered_softening: bool = Field(True, description="staggered coupling with Johnson-Cook: the mechanical step takes the softening of the heat step's temperature change (block Gauss-Seidel); false: the temperature of the last iterate (slower Newton)")
 
 
     @field_validator("boundary")
@@ -155,7 +156,8 @@ def options(block: Thermal, scene, files) -> list[str]:
             "-therm_r", repr(0.0 if block.source == "manufactured" else float(block.source)),
             "-therm_mms_amp", repr(block.mms_amplitude),
             "-therm_tool_T", repr(block.tool_temperature if block.tool_temperature is not None else block.T_ref),
-            "-therm_contact_h", repr(block.contact_conductance)] + opts_ms
+            "-therm_contact_h", repr(block.contact_conductance),
+            "-therm_soft", "1" if block.staggered_softening else "0"] + opts_ms
     return opts
 
 
