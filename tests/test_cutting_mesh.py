@@ -113,6 +113,8 @@ def test_bad_zones_are_refused_with_the_key(tmp_path):
      "WENDEL_BENCH_FBAR = '2': 1 (cutting.volumetric = \"fbar\"), 0 (\"cell\") or unset (as the scene says)"),
     ("cutting-paths", "WENDEL_BENCH_PATHS", "0",
      "WENDEL_BENCH_PATHS = '0': a whole number of paths from 1 to 20"),
+    ("cutting-paths", "WENDEL_BENCH_BEFORE", "23",
+     "WENDEL_BENCH_BEFORE = '23': one of 24, 25 (the loop before that session)"),
 ])
 def test_the_long_cut_benches_refuse_a_bad_setting_by_name_before_cutting(tmp_path, monkeypatch, name, var, value,
                                                                            words):

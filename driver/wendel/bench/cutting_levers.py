@@ -3,9 +3,10 @@
 The steel cut's first 200 um (40 increments of 5 um, remeshed every 8) at edge r/2 with F-bar, conduction and
 MUMPS (the settled-cut benches' scene, ``direct``'s cut made longer), as the scene says (``base``), the same again
 (``base again``: the loop is deterministic, its ``cutting.csv`` the same byte for byte), and once per lever:
-``numerics.newton_tol = 1e-6`` (the cut's own is 1e-8; below about 1e-4 its Newton iterations converge linearly,
-the heat and the Johnson-Cook softening being outside the tangent) and ``cutting.remesh_every = 16`` (half the
-re-equilibrations); session 24's two levers taken back one at a time and together (``cutting.relax_tol = 1e-8``:
+``numerics.newton_tol = 1e-6`` (the cut's own is 1e-8) and ``cutting.remesh_every = 16`` (half the
+re-equilibrations); session 25's lever taken back (``lagged softening``: ``thermal.staggered_softening = false``,
+the mechanical step blind to its heat step's Johnson-Cook softening: Newton linear below 1e-3, about 0.13-0.19 an
+iteration); session 24's two levers taken back one at a time and together with it (``cutting.relax_tol = 1e-8``:
 each stage of a re-equilibration converged; ``cutting.first_step = 1``: the whole first step on a new mesh), and,
 as a diagnostic, the cut without heat (``thermal.beta = 0``, adiabatic: no plastic or frictional heat). Rows:
 increments, step cuts, Newton iterations (of the increments accepted, of the re-equilibrations among them, and of
@@ -24,10 +25,12 @@ from pathlib import Path
 
 from . import register
 
-BEFORE_24 = {"relax_tol": 1e-8, "first_step": 1.0}     # the loop before session 24's two levers
+BEFORE = {"25": {"soft": False},                                        # before session 25's softening
+          "24": {"relax_tol": 1e-8, "first_step": 1.0, "soft": False}}   # before session 24's two levers too
 LEVERS = [("base", {}), ("base again", {}), ("newton_tol 1e-6", {"newton_tol": 1e-6}),
           ("remesh_every 16", {"remesh_every": 16}), ("stages converged", {"relax_tol": 1e-8}),
-          ("whole first step", {"first_step": 1.0}), ("before session 24", BEFORE_24), ("no heat", {"heat": False})]
+          ("whole first step", {"first_step": 1.0}), ("lagged softening", BEFORE["25"]),
+          ("before session 24", BEFORE["24"]), ("no heat", {"heat": False})]
 PHASES = ("assembly", "linear_solve", "constitutive", "failed_increments", "failed_launches")
 
 
@@ -41,6 +44,8 @@ def _scene(steps: int, lever: dict):
     for key in ("remesh_every", "relax_tol", "first_step"):
         if key in lever:
             setattr(scene.cutting, key, lever[key])
+    if "soft" in lever:             # the staggered step without the heat step's softening (before session 25)
+        scene.thermal.staggered_softening = lever["soft"]
     if "perturb" in lever:          # another round-off of the tool path (cutting-paths)
         scene.cutting.cut_length *= 1 + lever["perturb"] * 1e-13
     if lever.get("heat") is False:
@@ -94,7 +99,8 @@ def cutting_levers_bench(quick: bool, workdir: Path) -> list[dict]:
 
 @register("cutting-paths")
 def cutting_paths_bench(quick: bool, workdir: Path) -> list[dict]:
-    """The 200 um cut of ``cutting-levers`` as the scene says (``new``) and as before session 24 (``before``:
+    """The 200 um cut of ``cutting-levers`` as the scene says (``new``) and as before session 25 (``before``:
+    ``thermal.staggered_softening = false``; ``WENDEL_BENCH_BEFORE=24``: as before session 24, also
     ``cutting.relax_tol = 1e-8``, ``cutting.first_step = 1``) on ``WENDEL_BENCH_PATHS`` (default 4) tool paths that
     differ in their 13th digit (``cutting.cut_length`` times 1 + k 1e-13, k = 1, 2, ...): the cut's Newton path is
     chaotic (a path that differed in its last digit took 117 step cuts instead of 190 over 1.2 mm), so a lever
@@ -104,8 +110,12 @@ def cutting_paths_bench(quick: bool, workdir: Path) -> list[dict]:
     n = os.environ.get("WENDEL_BENCH_PATHS", "4")
     if not (n.isdigit() and 1 <= int(n) <= 20):
         raise ValueError(f"WENDEL_BENCH_PATHS = {n!r}: a whole number of paths from 1 to 20")
+    since = os.environ.get("WENDEL_BENCH_BEFORE", "25")
+    if since not in BEFORE:
+        raise ValueError(f"WENDEL_BENCH_BEFORE = {since!r}: one of {', '.join(sorted(BEFORE))} "
+                         f"(the loop before that session)")
     steps, rows = 8 if quick else 40, []
     for k in range(1, (2 if quick else int(n)) + 1):
-        for name, lever in (("new", {}), ("before", BEFORE_24)):
+        for name, lever in (("new", {}), ("before", BEFORE[since])):
             rows.append({"path": k, **_run(name, {**lever, "perturb": k}, steps, workdir / f"{name}-{k}")})
     return rows
