@@ -2,10 +2,12 @@
 
 A re-equilibration after a scheduled remesh that fails in the most stages on every gmsh mesh drops the remesh and
 goes on with the old mesh (when no cell of it is inverted); a forward step that fails even in its smallest cut is
-remeshed once and tried again (``remesh.on_failure``); F-bar re-equilibrates once with the cells' own volume change
+remeshed and tried again (``remesh.on_failure``; when the first step on that mesh fails so too, once more
+without the motion carried over the remesh, then the body is meshed again with another gmsh algorithm); F-bar re-equilibrates once with the cells' own volume change
 before it gives a remesh up; what cannot go on stops with a message that says what
 failed and keeps the accepted increments. The decisions are made on the loop's state, without FreeFEM (the remesh
-of a forward failure is a real one in ``test_a_step_that_fails_for_good_is_remeshed_once``)."""
+of a forward failure is a real one in
+``test_a_step_that_fails_for_good_is_remeshed_and_a_failing_first_step_meshed_again``)."""
 
 import csv
 import json
@@ -15,6 +17,7 @@ import pytest
 from wendel import freefem
 from wendel.cutting.fe import fe_scene
 from wendel.errors import StepCutError
+from wendel.loop import predictor
 from wendel.loop.checkpoint import RunFiles, State
 from wendel.loop.steps import RELAX_MAX, cut_step
 from wendel.remesh.again import AGAIN
@@ -113,7 +116,7 @@ def test_a_step_that_fails_for_good_stops_without_a_remesh_when_it_may_not(tmp_p
     assert "even after" in str(err.value) and state.remeshes == []
 
 
-def test_a_step_that_fails_for_good_is_remeshed_once(tmp_path):
+def test_a_step_that_fails_for_good_is_remeshed_and_a_failing_first_step_meshed_again(tmp_path):
     # A real cut (the steel scene's smoke with F-bar, 4 increments of 5 um) whose next step is made to fail in its
     # smallest cut: the last converged increment is remeshed (gmsh, transfer), the run re-equilibrates on the new mesh
     # (resumed, as the loop goes on after the remesh) and ends there; a second failure on that mesh stops it.
@@ -145,8 +148,31 @@ def test_a_step_that_fails_for_good_is_remeshed_once(tmp_path):
     assert state.last == (last + 1, lf_last) and not state.reequilibrate
     rows = list(csv.DictReader((root / "history.csv").open()))
     assert rows[-1]["increment"] == str(last + 1) and rows[-1]["reequilibration"] == "1"
-    state.pending = [lf]        # fails again right after the remesh: no second one
+    # the first step on that mesh fails in its smallest cut too: once more without the motion carried over the
+    # remesh as its first guess, then the mesh is given up with its re-equilibration (the increment's files and
+    # history rows go) and the same body meshed again with the next gmsh algorithm
+    launches = sum(launch["increments"] for launch in state.launches)
+    state.pending = [lf]
+    failure = freefem.NewtonFailure({"increment": last + 2, "load_factor": lf, "reason": "mesh would invert"})
+    assert "-predictor_du" in predictor.options(scene, files, state, dimension)
+    cut_step(scene, files, state, failure, said.append, dimension)
+    assert state.remeshes[-1]["first_guess_carried"] is False and state.pending == [lf]
+    assert predictor.options(scene, files, state, dimension) == [] and "no motion carried over" in said[-1]
+    cut_step(scene, files, state, failure, said.append, dimension)
+    rep = state.remeshes[-1]
+    assert len(state.remeshes) == 1 and rep["algorithm_2d_tries"] == 1 and rep["after_increment"] == last
+    assert state.reequilibrate and state.last == (last, lf_last) and state.pending == [lf_last]
+    assert sum(launch["increments"] for launch in state.launches) == launches - 1
+    assert not (root / "fem" / f"inc-{last + 1:04d}").exists()
+    assert list(csv.DictReader((root / "history.csv").open()))[-1]["increment"] == str(last)
+    assert f"the first step on remesh 1's mesh: mesh would invert, even after" in said[-2]
+    assert f"meshing again with gmsh algorithm {AGAIN[0]}" in said[-2]
+    save(files, scene, state, dimension)
+    run("", resume=root, progress=lambda *_: None)      # re-equilibrated on the body's other mesh
+    files, scene, state, dimension = load_state(root)
+    assert state.last == (last + 1, lf_last) and not state.reequilibrate
+    state.remeshes[-1].update(algorithm_2d_tries=len(AGAIN), first_guess_carried=False)   # all tried: stop
+    state.pending = [lf]
     with pytest.raises(StepCutError):
-        cut_step(scene, files, state, freefem.NewtonFailure({"increment": last + 2, "load_factor": lf,
-                                                             "reason": "mesh would invert"}), said.append, dimension)
+        cut_step(scene, files, state, failure, said.append, dimension)
     assert len(state.remeshes) == len(json.loads((root / "summary.json").read_text())["remeshes"])

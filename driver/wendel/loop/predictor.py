@@ -13,7 +13,8 @@ over (``-predictor_dlf``) and the load factor of the launch's start state (``-pr
   location, :func:`wendel.remesh.transfer.transfer_nodal`), written beside the segment's transferred state.
 
 The re-equilibration itself is at the same load factor (s = 0: no guess) and keeps the motion for the
-increment after it. P1 continuous elements only (the node files are the P1 displacement); nothing for a
+increment after it; when that increment fails even in its smallest cut, it is tried once more without it
+(the remesh's ``first_guess_carried = false``, :func:`wendel.loop.steps._without_predictor`). P1 continuous elements only (the node files are the P1 displacement); nothing for a
 fresh start (increment 1), where predictor.idp's own rule holds.
 """
 
@@ -31,6 +32,8 @@ def options(scene, files, state, dimension: int) -> list[str]:
     inc, lf = state.last
     seg = state.segment(inc + 1)
     if state.reequilibrate or seg["first"] == inc:      # the segment starts at (or with) this launch's state
+        if seg is state.segments[-1] and state.remeshes and state.remeshes[-1].get("first_guess_carried") is False:
+            return []       # its first step failed so for good (wendel.loop.steps._without_predictor)
         got = _transferred(files, state, seg, dimension)
         if got is None:
             return []

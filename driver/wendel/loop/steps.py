@@ -79,7 +79,9 @@ def cut_step(scene: Scene, files: RunFiles, state: State, failure: freefem.Newto
     mid = lf_prev + 0.5 * (lf_fail - lf_prev)
     smallest = scene.loading.nominal_step() / 2 ** scene.loading.max_cuts
     if reason == "limit load reached" or abs(mid - lf_prev) < smallest * (1 - 1e-9):
-        if reason != "limit load reached" and _remesh(scene, files, state, dimension, progress, inc, reason):
+        if reason != "limit load reached" and (_remesh(scene, files, state, dimension, progress, inc, reason)
+                                               or _without_predictor(scene, state, progress, inc, reason)
+                                               or _mesh_again(scene, files, state, progress, inc, reason)):
             return
         what = "limit load reached" if reason == "limit load reached" else \
             f"{reason}, even after {scene.loading.max_cuts} step halvings (loading.max_cuts)"
@@ -147,6 +149,53 @@ def _remesh(scene: Scene, files: RunFiles, state: State, dimension: int, progres
              f"increment {last} and going on (remesh.on_failure)")
     maybe_remesh(scene, files, state, dimension, progress, failed=True)
     return True
+
+
+def _first_on_new_mesh(scene: Scene, state: State) -> bool:
+    """Whether the last accepted increment is the re-equilibration of the last remesh (the step that failed is the
+    first forward step on that mesh)."""
+    return bool(scene.remesh and scene.remesh.on_failure and state.remeshes and not state.reequilibrate
+                and len(state.segments) > 1 and state.last[0] == state.segments[-1]["first"])
+
+
+def _without_predictor(scene: Scene, state: State, progress, inc: int, reason: str) -> bool:
+    """The first forward step on a new mesh failed even in its smallest cut with the first guess carried over the
+    remesh (:mod:`wendel.loop.predictor`: the old mesh's last motion): once more from the re-equilibrated state
+    itself. Measured (README, session 26): the 2.4 mm F-bar cut with conduction, stopped at 2,068 um with its first
+    step failing so on three meshes of the body, went on at once from the re-equilibrated state."""
+    if scene.numerics.predictor != "extrapolate" or not _first_on_new_mesh(scene, state):
+        return False
+    rep = state.remeshes[-1]
+    if rep.get("first_guess_carried") is False:
+        return False
+    rep["first_guess_carried"] = False
+    progress(f"  increment {inc}: {reason}, even after {scene.loading.max_cuts} step halvings, the first step on "
+             f"remesh {rep.get('remesh')}'s mesh; again from the re-equilibrated state (no motion carried over)")
+    return True
+
+
+def _mesh_again(scene: Scene, files: RunFiles, state: State, progress, inc: int, reason: str) -> bool:
+    """The first forward step on a new mesh failed even in its smallest cut, its re-equilibration converged: that
+    mesh is given up with its re-equilibration and the same deformed body meshed again with the next gmsh 2D
+    algorithm (:data:`wendel.remesh.again.AGAIN`, as after a re-equilibration that failed), and the loop goes on
+    from the increment the remesh was made from. Measured (README, session 26): the 2.4 mm F-bar cut with
+    conduction stopped at 1,551 um so, its first step on remesh 67 failing in every cut."""
+    from ..remesh.again import AGAIN, remesh_again
+    from ..remesh.batch import forget
+    if not _first_on_new_mesh(scene, state):
+        return False
+    rep = state.remeshes[-1]
+    if rep.get("dimension") != 2 or rep.get("algorithm_2d_tries", 0) >= len(AGAIN):
+        return False
+    forget(scene, files, state, state.last[0] - 1)          # the re-equilibration on the mesh given up
+    kept = [launch for launch in state.launches if launch["increments"] > 0]
+    if kept:
+        kept[-1]["increments"] -= 1
+    state.pending = [lf for lf in state.pending if _target(scene, lf)]
+    state.pending[:0] = [rep["load_factor"]] + rep.get("first_steps", [])     # as drop_last_remesh takes them
+    state.reequilibrate = True
+    return remesh_again(scene, files, state, progress, f"the first step on remesh {rep.get('remesh')}'s mesh: "
+                        f"{reason}, even after {scene.loading.max_cuts} step halvings")
 
 
 def _hint(scene: Scene, reason: str) -> str:

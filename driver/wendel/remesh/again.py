@@ -10,7 +10,7 @@ from __future__ import annotations
 AGAIN = (5, 1)      # gmsh 2D algorithms (Delaunay, MeshAdapt) of a remesh made again after its re-equilibration failed
 
 
-def remesh_again(scene, files, state, progress) -> bool:
+def remesh_again(scene, files, state, progress, what: str = "the re-equilibration failed") -> bool:
     """The re-equilibration after the last remesh failed even in the most stages: mesh the same deformed body
     again with the next gmsh 2D algorithm of ``AGAIN`` (the same sizes, other triangles; whether a
     re-equilibration converges depends on the mesh: measured on the FE cut) and re-equilibrate that. False when
@@ -20,8 +20,7 @@ def remesh_again(scene, files, state, progress) -> bool:
     if rep.get("dimension") != 2 or tried >= len(AGAIN):
         return False
     drop_last_remesh(state)
-    progress(f"  increment {rep['after_increment']}: the re-equilibration failed; meshing again with gmsh algorithm "
-             f"{AGAIN[tried]}")
+    progress(f"  increment {rep['after_increment']}: {what}; meshing again with gmsh algorithm {AGAIN[tried]}")
     from .step import maybe_remesh
     maybe_remesh(scene, files, state, 2, progress, again=tried + 1, failed=rep.get("after_failed_step", False))
     return True

@@ -114,12 +114,18 @@ def roll_back(scene, files, state, first: int) -> list[int]:
             or state.quality.get(i, {}).get("inverted", 0) > 0 or i in r.at]
     if not poor or poor[0] == state.last[0]:
         return []
-    keep = poor[0]
+    dropped = forget(scene, files, state, poor[0])
+    state.pending[:0] = [lf for _, lf in dropped]
+    return [i for i, _ in dropped]
+
+
+def forget(scene, files, state, keep: int) -> list[tuple[int, float]]:
+    """Drop the accepted increments after ``keep`` with their files (increment folder, VTU, history and Newton
+    rows, the .pvd's entries); returns them (number, load factor)."""
     from ..results import summary, vtu
 
     dropped = [(i, lf) for i, lf in state.accepted if i > keep]
     state.accepted = [(i, lf) for i, lf in state.accepted if i <= keep]
-    state.pending[:0] = [lf for _, lf in dropped]
     for i, _ in dropped:
         state.quality.pop(i, None)
         shutil.rmtree(files.fem / f"inc-{i:04d}", ignore_errors=True)
@@ -127,4 +133,4 @@ def roll_back(scene, files, state, first: int) -> list[int]:
     summary.truncate_history(files.root, keep)
     if scene.output.vtu and state.accepted:
         vtu.write_pvd(files.root / "results.pvd", [(lf, f"vtu/inc-{i:04d}.vtu") for i, lf in state.accepted])
-    return [i for i, _ in dropped]
+    return dropped
