@@ -115,6 +115,9 @@ def test_bad_zones_are_refused_with_the_key(tmp_path):
      "WENDEL_BENCH_PATHS = '0': a whole number of paths from 1 to 20"),
     ("cutting-paths", "WENDEL_BENCH_BEFORE", "23",
      "WENDEL_BENCH_BEFORE = '23': one of 24, 25 (the loop before that session)"),
+    ("cutting-paths", "WENDEL_BENCH_LEVER", "base",
+     "WENDEL_BENCH_LEVER = 'base': one of newton_tol-1e-6, remesh_every-16, stages-converged, whole-first-step, "
+     "lagged-softening, before-session-24, no-heat, sixteenth-first-step, 10-um-steps (cutting-levers' levers)"),
 ])
 def test_the_long_cut_benches_refuse_a_bad_setting_by_name_before_cutting(tmp_path, monkeypatch, name, var, value,
                                                                            words):

@@ -3,8 +3,10 @@
 The steel cut's first 200 um (40 increments of 5 um, remeshed every 8) at edge r/2 with F-bar, conduction and
 MUMPS (the settled-cut benches' scene, ``direct``'s cut made longer), as the scene says (``base``), the same again
 (``base again``: the loop is deterministic, its ``cutting.csv`` the same byte for byte), and once per lever:
-``numerics.newton_tol = 1e-6`` (the cut's own is 1e-8) and ``cutting.remesh_every = 16`` (half the
-re-equilibrations); session 25's lever taken back (``lagged softening``: ``thermal.staggered_softening = false``,
+``numerics.newton_tol = 1e-6`` (the cut's own is 1e-8), ``cutting.remesh_every = 16`` (half the
+re-equilibrations), ``cutting.first_step = 0.0625`` (a sixteenth of the step first on a new mesh, not a quarter)
+and steps of 10 um remeshed every 4 (the same travel between remeshes); session 25's lever taken back
+(``lagged softening``: ``thermal.staggered_softening = false``,
 the mechanical step blind to its heat step's Johnson-Cook softening: Newton linear below 1e-3, about 0.13-0.19 an
 iteration); session 24's two levers taken back one at a time and together with it (``cutting.relax_tol = 1e-8``:
 each stage of a re-equilibration converged; ``cutting.first_step = 1``: the whole first step on a new mesh), and,
@@ -30,7 +32,8 @@ BEFORE = {"25": {"soft": False},                                        # before
 LEVERS = [("base", {}), ("base again", {}), ("newton_tol 1e-6", {"newton_tol": 1e-6}),
           ("remesh_every 16", {"remesh_every": 16}), ("stages converged", {"relax_tol": 1e-8}),
           ("whole first step", {"first_step": 1.0}), ("lagged softening", BEFORE["25"]),
-          ("before session 24", BEFORE["24"]), ("no heat", {"heat": False})]
+          ("before session 24", BEFORE["24"]), ("no heat", {"heat": False}),
+          ("sixteenth first step", {"first_step": 0.0625}), ("10 um steps", {"step_um": 10, "remesh_every": 4})]
 PHASES = ("assembly", "linear_solve", "constitutive", "failed_increments", "failed_launches")
 
 
@@ -46,6 +49,8 @@ def _scene(steps: int, lever: dict):
             setattr(scene.cutting, key, lever[key])
     if "soft" in lever:             # the staggered step without the heat step's softening (before session 25)
         scene.thermal.staggered_softening = lever["soft"]
+    if "step_um" in lever:          # the same travel in steps of that length [um]
+        scene.loading.steps = round(scene.cutting.cut_length / (lever["step_um"] * 1e-6))
     if "perturb" in lever:          # another round-off of the tool path (cutting-paths)
         scene.cutting.cut_length *= 1 + lever["perturb"] * 1e-13
     if lever.get("heat") is False:
@@ -104,7 +109,8 @@ def cutting_paths_bench(quick: bool, workdir: Path) -> list[dict]:
     ``cutting.relax_tol = 1e-8``, ``cutting.first_step = 1``) on ``WENDEL_BENCH_PATHS`` (default 4) tool paths that
     differ in their 13th digit (``cutting.cut_length`` times 1 + k 1e-13, k = 1, 2, ...): the cut's Newton path is
     chaotic (a path that differed in its last digit took 117 step cuts instead of 190 over 1.2 mm), so a lever
-    is judged over several paths, new and before interleaved. ``--quick``: 2 paths of 40 um (no remesh in them: a
+    is judged over several paths, new and before interleaved. ``WENDEL_BENCH_LEVER``: against one of
+    ``cutting-levers``' levers instead (its name with hyphens, e.g. ``sixteenth-first-step``). ``--quick``: 2 paths of 40 um (no remesh in them: a
     check of the bench, not of the levers)."""
     import os
     n = os.environ.get("WENDEL_BENCH_PATHS", "4")
@@ -114,8 +120,15 @@ def cutting_paths_bench(quick: bool, workdir: Path) -> list[dict]:
     if since not in BEFORE:
         raise ValueError(f"WENDEL_BENCH_BEFORE = {since!r}: one of {', '.join(sorted(BEFORE))} "
                          f"(the loop before that session)")
+    against = ("before", BEFORE[since])
+    named = {name.replace(" ", "-"): (name.replace(" ", "-"), lever) for name, lever in LEVERS[2:]}
+    if "WENDEL_BENCH_LEVER" in os.environ:
+        lever = os.environ["WENDEL_BENCH_LEVER"]
+        if lever not in named:
+            raise ValueError(f"WENDEL_BENCH_LEVER = {lever!r}: one of {', '.join(named)} (cutting-levers' levers)")
+        against = named[lever]
     steps, rows = 8 if quick else 40, []
     for k in range(1, (2 if quick else int(n)) + 1):
-        for name, lever in (("new", {}), ("before", BEFORE[since])):
+        for name, lever in (("new", {}), against):
             rows.append({"path": k, **_run(name, {**lever, "perturb": k}, steps, workdir / f"{name}-{k}")})
     return rows
