@@ -3,9 +3,9 @@
 A re-equilibration after a scheduled remesh that fails in the most stages on every gmsh mesh drops the remesh and
 goes on with the old mesh (when no cell of it is inverted); a forward step that fails even in its smallest cut is
 remeshed and tried again (``remesh.on_failure``; when the first step on that mesh fails so too, once more
-without the motion carried over the remesh, then the body is meshed again with another gmsh algorithm); F-bar re-equilibrates once with the cells' own volume change
-before it gives a remesh up; what cannot go on stops with a message that says what
-failed and keeps the accepted increments. The decisions are made on the loop's state, without FreeFEM (the remesh
+without the motion carried over the remesh, then the body is meshed again with another gmsh algorithm); F-bar
+re-equilibrates once with the cells' own volume change before it gives a remesh up; what cannot go on stops with
+a message that says what failed and keeps the accepted increments. The decisions are made on the loop's state, without FreeFEM (the remesh
 of a forward failure is a real one in
 ``test_a_step_that_fails_for_good_is_remeshed_and_a_failing_first_step_meshed_again``)."""
 

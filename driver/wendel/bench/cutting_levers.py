@@ -110,8 +110,8 @@ def cutting_paths_bench(quick: bool, workdir: Path) -> list[dict]:
     differ in their 13th digit (``cutting.cut_length`` times 1 + k 1e-13, k = 1, 2, ...): the cut's Newton path is
     chaotic (a path that differed in its last digit took 117 step cuts instead of 190 over 1.2 mm), so a lever
     is judged over several paths, new and before interleaved. ``WENDEL_BENCH_LEVER``: against one of
-    ``cutting-levers``' levers instead (its name with hyphens, e.g. ``sixteenth-first-step``). ``--quick``: 2 paths of 40 um (no remesh in them: a
-    check of the bench, not of the levers)."""
+    ``cutting-levers``' levers instead (its name with hyphens, e.g. ``sixteenth-first-step``). ``--quick``: 2 paths
+    of 40 um (no remesh in them: a check of the bench, not of the levers)."""
     import os
     n = os.environ.get("WENDEL_BENCH_PATHS", "4")
     if not (n.isdigit() and 1 <= int(n) <= 20):

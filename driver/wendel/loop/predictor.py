@@ -14,8 +14,9 @@ over (``-predictor_dlf``) and the load factor of the launch's start state (``-pr
 
 The re-equilibration itself is at the same load factor (s = 0: no guess) and keeps the motion for the
 increment after it; when that increment fails even in its smallest cut, it is tried once more without it
-(the remesh's ``first_guess_carried = false``, :func:`wendel.loop.steps._without_predictor`). P1 continuous elements only (the node files are the P1 displacement); nothing for a
-fresh start (increment 1), where predictor.idp's own rule holds.
+(the remesh's ``first_guess_carried = false``, :func:`wendel.loop.steps._without_predictor`). P1 continuous
+elements only (the node files are the P1 displacement); nothing for a fresh start (increment 1), where
+predictor.idp's own rule holds.
 """
 
 from __future__ import annotations

@@ -80,7 +80,8 @@ def cut_step(scene: Scene, files: RunFiles, state: State, failure: freefem.Newto
     smallest = scene.loading.nominal_step() / 2 ** scene.loading.max_cuts
     if reason == "limit load reached" or abs(mid - lf_prev) < smallest * (1 - 1e-9):
         if reason != "limit load reached" and (_remesh(scene, files, state, dimension, progress, inc, reason)
-                                               or _without_predictor(scene, state, progress, inc, reason)
+                                               or _without_predictor(scene, files, state, dimension, progress,
+                                                                     inc, reason)
                                                or _mesh_again(scene, files, state, progress, inc, reason)):
             return
         what = "limit load reached" if reason == "limit load reached" else \
@@ -158,16 +159,18 @@ def _first_on_new_mesh(scene: Scene, state: State) -> bool:
                 and len(state.segments) > 1 and state.last[0] == state.segments[-1]["first"])
 
 
-def _without_predictor(scene: Scene, state: State, progress, inc: int, reason: str) -> bool:
+def _without_predictor(scene: Scene, files: RunFiles, state: State, dimension: int, progress, inc: int,
+                       reason: str) -> bool:
     """The first forward step on a new mesh failed even in its smallest cut with the first guess carried over the
     remesh (:mod:`wendel.loop.predictor`: the old mesh's last motion): once more from the re-equilibrated state
     itself. Measured (README, session 26): the 2.4 mm F-bar cut with conduction, stopped at 2,068 um with its first
     step failing so on three meshes of the body, went on at once from the re-equilibrated state."""
+    from . import predictor
     if scene.numerics.predictor != "extrapolate" or not _first_on_new_mesh(scene, state):
         return False
     rep = state.remeshes[-1]
-    if rep.get("first_guess_carried") is False:
-        return False
+    if rep.get("first_guess_carried") is False or not predictor.options(scene, files, state, dimension):
+        return False            # tried so already, or no motion was carried (the same try again)
     rep["first_guess_carried"] = False
     progress(f"  increment {inc}: {reason}, even after {scene.loading.max_cuts} step halvings, the first step on "
              f"remesh {rep.get('remesh')}'s mesh; again from the re-equilibrated state (no motion carried over)")

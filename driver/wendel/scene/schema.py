@@ -295,8 +295,9 @@ class Remesh(Strict):
     max_remeshes: int = Field(20, ge=0, description="remeshes allowed in one run")
     at: list[int] = Field(default_factory=list, description="increments after which to remesh whatever the quality")
     on_failure: bool = Field(True, description="a step that fails even after loading.max_cuts halvings: remesh "
-                             "the last converged increment and go on (once per mesh; when the first step on the new mesh fails so, "
-                             "the body is meshed again with other gmsh algorithms; false: stop there)")
+                             "the last converged increment and go on (once per mesh; when the first step on the new "
+                             "mesh fails so, it is tried without the motion carried over, then the body meshed again "
+                             "with other gmsh algorithms; false: stop there)")
     relax_steps: int = Field(1, ge=1, le=64, description="the re-equilibration after a remesh releases the "
                              "transferred state's out-of-balance forces in this many stages, each converged by "
                              "Newton (1: at once) [1]")
