@@ -235,11 +235,12 @@ def _steady(quick: bool, workdir: Path, vol: str, remesh_every: int | None = Non
             length: float = 1.2e-3, block: float = 2.6e-3, folder: str | None = None, reuse: bool = False) -> list[dict]:
     """The 1.2 mm cut of ``cutting-steady`` (or ``length`` [m] on a block ``block`` [m] long, in ``folder``) with
     ``vol`` (and ``remesh_every`` increments between remeshes instead of the scene's 8, if given): the remesh-cycle
-    means, then a row of the last window's spreads and drifts, increments, step cuts, Newton iterations, wall time.
+    means, then a row of the last window's spreads and drifts, increments, step cuts, Newton iterations, wall time
+    and ``steady_at_s``, the wall time when the first steady window closed (:func:`wendel.cutting.fe_steady.reached`).
     ``reuse``: a finished cut of the same scene in the folder is read (its summary's wall time), an unfinished one refused."""
     import csv
 
-    from ..cutting.fe_steady import steady, window
+    from ..cutting.fe_steady import reached, steady, window
     div = edge()                # WENDEL_BENCH_EDGE: the edge size r / div (folder r<div>-...), default r/2
     scene = _scene(div, 1, quick=False, vol=vol)
     folder = folder or ("r2-long" if not remesh_every else f"r2-long-remesh{remesh_every}")
@@ -287,6 +288,7 @@ def _steady(quick: bool, workdir: Path, vol: str, remesh_every: int | None = Non
                  "mean_Ft_N": w["steady_Ft_N"], "mean_chip_um": w["steady_chip_m"] * 1e6}
     filt = st["filtered"]
     res.append({"travel_um": rows[-1]["tool_travel_m"] * 1e6, "steady_from_um": found["start_m"] * 1e6 if found else None,
+                "steady_at_s": reached(out, rows, found),
                 "filtered_from_um": filt["start_m"] * 1e6 if filt else None, **means,
                 **{f"fspread_{k}": v for k, v in st["last_window_spreads"]["filtered"].items()},
                 **{f"spread_{k}": v for k, v in st["last_window_spreads"]["cycles"].items()},

@@ -173,6 +173,38 @@ def window(rows: list[dict], length: float) -> dict:
     return out
 
 
+def reached(root: Path, rows: list[dict], found: dict | None) -> float | None:
+    """The run's wall time [s] when a steady window ``found`` (:func:`steady`'s ``cycles`` or ``filtered``) closed:
+    the FreeFEM launches (``checkpoint.json``) up to the one that accepted the first increment at the window's end,
+    with the first mesh and the remeshes before that increment; Python's start and the report excepted. None
+    without a window.
+
+    >>> import json, tempfile
+    >>> d = Path(tempfile.mkdtemp())
+    >>> _ = (d / "checkpoint.json").write_text(json.dumps({"mesh_seconds": 0.5, "accepted": [[1, 0.1], [2, 0.2],
+    ...     [3, 0.2], [4, 0.3]], "launches": [{"wall": 10.0, "increments": 2}, {"wall": 4.0, "increments": 0},
+    ...     {"wall": 6.0, "increments": 2}], "remeshes": [{"after_increment": 2, "remesh_seconds": 1.0,
+    ...     "transfer_seconds": 0.5}]}))
+    >>> rows = [{"increment": float(i), "tool_travel_m": t} for i, t in ((1, 1e-6), (2, 2e-6), (3, 2e-6), (4, 3e-6))]
+    >>> reached(d, rows, {"start_m": 0.0, "end_m": 2e-6}), reached(d, rows, {"start_m": 0.0, "end_m": 2.5e-6})
+    (10.5, 22.0)
+    """
+    import json
+    if not found:
+        return None
+    ck = json.loads((Path(root) / "checkpoint.json").read_text())
+    inc = next((int(r["increment"]) for r in rows if r["tool_travel_m"] >= found["end_m"] - 1e-12),
+               int(rows[-1]["increment"]))
+    need = sum(1 for i, _ in ck["accepted"] if i <= inc)          # accepted increments up to it
+    wall, n = ck.get("mesh_seconds", 0.0), 0
+    for launch in ck["launches"]:
+        if n >= need:
+            break
+        wall, n = wall + launch["wall"], n + launch["increments"]
+    return wall + sum(r.get("remesh_seconds", 0.0) + r.get("transfer_seconds", 0.0) for r in ck.get("remeshes", [])
+                      if r.get("after_increment", 0) < inc)
+
+
 def _trend(rows: list[dict], key: str, length: float) -> float:
     """The change over ``length`` of travel of a least-squares line through the window, over its mean: the part
     of a spread that is a drift (a cut still settling) rather than a scatter.
