@@ -5,8 +5,8 @@ goes on with the old mesh (when no cell of it is inverted); a forward step that 
 remeshed and tried again (``remesh.on_failure``; when the first step on that mesh fails so too, once more
 without the motion carried over the remesh, then the body is meshed again with another gmsh algorithm); F-bar
 re-equilibrates once with the cells' own volume change before it gives a remesh up; what cannot go on stops with
-a message that says what failed and keeps the accepted increments. The decisions are made on the loop's state, without FreeFEM (the remesh
-of a forward failure is a real one in
+a message that says what failed and keeps the accepted increments. The decisions are made on the loop's state,
+without FreeFEM (the remesh of a forward failure is a real one in
 ``test_a_step_that_fails_for_good_is_remeshed_and_a_failing_first_step_meshed_again``)."""
 
 import csv

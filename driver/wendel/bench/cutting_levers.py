@@ -121,12 +121,12 @@ def cutting_paths_bench(quick: bool, workdir: Path) -> list[dict]:
         raise ValueError(f"WENDEL_BENCH_BEFORE = {since!r}: one of {', '.join(sorted(BEFORE))} "
                          f"(the loop before that session)")
     against = ("before", BEFORE[since])
-    named = {name.replace(" ", "-"): (name.replace(" ", "-"), lever) for name, lever in LEVERS[2:]}
+    named = {name.replace(" ", "-"): lever for name, lever in LEVERS[2:]}
     if "WENDEL_BENCH_LEVER" in os.environ:
-        lever = os.environ["WENDEL_BENCH_LEVER"]
-        if lever not in named:
-            raise ValueError(f"WENDEL_BENCH_LEVER = {lever!r}: one of {', '.join(named)} (cutting-levers' levers)")
-        against = named[lever]
+        name = os.environ["WENDEL_BENCH_LEVER"]
+        if name not in named:
+            raise ValueError(f"WENDEL_BENCH_LEVER = {name!r}: one of {', '.join(named)} (cutting-levers' levers)")
+        against = (name, named[name])
     steps, rows = 8 if quick else 40, []
     for k in range(1, (2 if quick else int(n)) + 1):
         for name, lever in (("new", {}), against):

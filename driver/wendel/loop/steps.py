@@ -183,22 +183,15 @@ def _mesh_again(scene: Scene, files: RunFiles, state: State, progress, inc: int,
     algorithm (:data:`wendel.remesh.again.AGAIN`, as after a re-equilibration that failed), and the loop goes on
     from the increment the remesh was made from. Measured (README, session 26): the 2.4 mm F-bar cut with
     conduction stopped at 1,551 um so, its first step on remesh 67 failing in every cut."""
-    from ..remesh.again import AGAIN, remesh_again
+    from ..remesh.again import can_mesh_again, remesh_again
     from ..remesh.batch import forget
-    if not _first_on_new_mesh(scene, state):
+    if not (_first_on_new_mesh(scene, state) and can_mesh_again(state.remeshes[-1])):
         return False
     rep = state.remeshes[-1]
-    if rep.get("dimension") != 2 or rep.get("algorithm_2d_tries", 0) >= len(AGAIN):
-        return False
     forget(scene, files, state, state.last[0] - 1)          # the re-equilibration on the mesh given up
-    kept = [launch for launch in state.launches if launch["increments"] > 0]
-    if kept:
-        kept[-1]["increments"] -= 1
-    state.pending = [lf for lf in state.pending if _target(scene, lf)]
-    state.pending[:0] = [rep["load_factor"]] + rep.get("first_steps", [])     # as drop_last_remesh takes them
-    state.reequilibrate = True
     return remesh_again(scene, files, state, progress, f"the first step on remesh {rep.get('remesh')}'s mesh: "
-                        f"{reason}, even after {scene.loading.max_cuts} step halvings")
+                        f"{reason}, even after {scene.loading.max_cuts} step halvings",
+                        pending=[lf for lf in state.pending if _target(scene, lf)])
 
 
 def _hint(scene: Scene, reason: str) -> str:

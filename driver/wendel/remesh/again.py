@@ -10,28 +10,39 @@ from __future__ import annotations
 AGAIN = (5, 1)      # gmsh 2D algorithms (Delaunay, MeshAdapt) of a remesh made again after its re-equilibration failed
 
 
-def remesh_again(scene, files, state, progress, what: str = "the re-equilibration failed") -> bool:
+def can_mesh_again(rep: dict) -> bool:
+    """Whether the body of remesh report ``rep`` has a gmsh 2D algorithm of ``AGAIN`` left to be meshed with."""
+    return rep.get("dimension") == 2 and rep.get("algorithm_2d_tries", 0) < len(AGAIN)
+
+
+def remesh_again(scene, files, state, progress, what: str = "the re-equilibration failed",
+                 pending: list | None = None) -> bool:
     """The re-equilibration after the last remesh failed even in the most stages: mesh the same deformed body
     again with the next gmsh 2D algorithm of ``AGAIN`` (the same sizes, other triangles; whether a
     re-equilibration converges depends on the mesh: measured on the FE cut) and re-equilibrate that. False when
-    every algorithm has been tried (or in 3D)."""
+    every algorithm has been tried (or in 3D). ``pending``: the load factors to go on with (default: those after
+    the remesh's own, :func:`drop_last_remesh`)."""
     rep = state.remeshes[-1]
     tried = rep.get("algorithm_2d_tries", 0)
-    if rep.get("dimension") != 2 or tried >= len(AGAIN):
+    if not can_mesh_again(rep):
         return False
-    drop_last_remesh(state)
+    drop_last_remesh(state, pending)
     progress(f"  increment {rep['after_increment']}: {what}; meshing again with gmsh algorithm {AGAIN[tried]}")
     from .step import maybe_remesh
     maybe_remesh(scene, files, state, 2, progress, again=tried + 1, failed=rep.get("after_failed_step", False))
     return True
 
 
-def drop_last_remesh(state) -> dict:
+def drop_last_remesh(state, pending: list | None = None) -> dict:
     """Undo the last remesh whose re-equilibration failed (its report, mesh segment and re-equilibration load
-    factor): the loop stands after the increment it was made from, on the mesh before it. Its report."""
+    factor, or ``pending`` instead of what follows them): the loop stands after the increment it was made from,
+    on the mesh before it. Its report."""
     rep = state.remeshes.pop()
     state.segments.pop()
-    del state.pending[:1 + len(rep.get("first_steps", []))]
+    if pending is None:
+        del state.pending[:1 + len(rep.get("first_steps", []))]
+    else:
+        state.pending = pending
     state.reequilibrate = False
     return rep
 

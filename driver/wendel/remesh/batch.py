@@ -96,7 +96,6 @@ def settle(scene, files, state, dimension: int, first: int, progress) -> bool:
     if dropped:
         from ..loop.checkpoint import save
 
-        state.launches[-1]["increments"] -= len(dropped)
         save(files, scene, state, dimension)
         progress(f"  increments {dropped[0]}-{dropped[-1]} dropped: the mesh was poor before them")
     return bool(dropped) or (bool(state.accepted) and stopped_at(files.fem) == state.last[0])
@@ -121,11 +120,18 @@ def roll_back(scene, files, state, first: int) -> list[int]:
 
 def forget(scene, files, state, keep: int) -> list[tuple[int, float]]:
     """Drop the accepted increments after ``keep`` with their files (increment folder, VTU, history and Newton
-    rows, the .pvd's entries); returns them (number, load factor)."""
+    rows, the .pvd's entries), and from the counts of the launches that accepted them (the last ones that did);
+    returns them (number, load factor)."""
     from ..results import summary, vtu
 
     dropped = [(i, lf) for i, lf in state.accepted if i > keep]
     state.accepted = [(i, lf) for i, lf in state.accepted if i <= keep]
+    left = len(dropped)
+    for launch in reversed(state.launches):
+        take = min(left, launch["increments"])
+        launch["increments"], left = launch["increments"] - take, left - take
+        if not left:
+            break
     for i, _ in dropped:
         state.quality.pop(i, None)
         shutil.rmtree(files.fem / f"inc-{i:04d}", ignore_errors=True)
