@@ -122,7 +122,10 @@ def cutting_ti_bench(quick: bool, workdir: Path) -> list[dict]:
     ``WENDEL_BENCH_CUT_MM``: a longer cut [mm] (0.4 to 20) on a block 0.6 mm longer than the cut (folder
     ``ti-r2-<um>um``), with the steady-state detector's spreads and drifts over the last h (``cutting-steady``'s).
     ``WENDEL_BENCH_SNAP=1``: with ``cutting.snap_to_tool`` (folder ``...-snap``). ``WENDEL_BENCH_FBAR=1``: with
-    ``cutting.volumetric = "fbar"`` (folder ``...-fbar``), 0 or unset: as the scene says (the P1 cell's own)."""
+    ``cutting.volumetric = "fbar"`` (folder ``...-fbar``), 0 or unset: as the scene says (the P1 cell's own).
+    ``WENDEL_BENCH_CONDUCTION=1``: heat conduction and frictional heat (``thermal.coupling = "staggered"``, folder
+    ``...-conduction``); ``WENDEL_BENCH_MUMPS=1``: MUMPS (``...-mumps``); ``WENDEL_BENCH_UNTIL_STEADY=1``: the cut ends
+    at its steady state (``cutting.stop_when_steady``, ``...-until-steady``), ``steady_at_s`` its wall time there."""
     import os
 
     from ..cutting.scene import predict
@@ -146,14 +149,25 @@ def cutting_ti_bench(quick: bool, workdir: Path) -> list[dict]:
     scene.cutting.edge_size = scene.cutting.edge_radius / 2
     workdir.mkdir(parents=True, exist_ok=True)
     name = ("ti-r2" if mm is None or quick else f"ti-r2-{float(mm) * 1e3:.0f}um") + ("-snap" if snap else "") + ("-fbar" if fbar else "")
-    row = _case("adiabatic", quick, workdir, scene=scene, scene_path=path, name=name)
+    conduction = env_flag("WENDEL_BENCH_CONDUCTION", 'thermal.coupling = "staggered"')
+    name += "-conduction" if conduction else ""
+    if env_flag("WENDEL_BENCH_MUMPS", 'numerics.direct = "mumps"'):
+        scene.numerics.direct, name = "mumps", name + "-mumps"
+    if env_flag("WENDEL_BENCH_UNTIL_STEADY", "cutting.stop_when_steady"):
+        scene.cutting.stop_when_steady, name = True, name + "-until-steady"
+    row = _case("staggered" if conduction else "adiabatic", quick, workdir, scene=scene, scene_path=path, name=name)
     if mm is not None and not quick:
         import csv
 
-        from ..cutting.fe_steady import steady
+        from ..cutting.fe_steady import reached, steady
         cut = [{k: float(v) for k, v in r.items()} for r in csv.DictReader((workdir / name / "cutting.csv").open())]
         st = steady(cut, scene.cutting.uncut_thickness)
         row["steady_from_um"] = st["cycles"]["start_m"] * 1e6 if st["cycles"] else None
+        row["steady_to_um"] = st["cycles"]["end_m"] * 1e6 if st["cycles"] else None
+        row["steady_at_s"] = reached(workdir / name, cut, st["cycles"])
+        row["travel_um"] = cut[-1]["tool_travel_m"] * 1e6
+        row.update({f"steady_{k}": v for k, v in (st["cycles"] or {}).get("values", {}).items()})
+        row.update({f"steady_spread_{k}": v for k, v in (st["cycles"] or {}).get("spreads", {}).items()})
         row["filtered_from_um"] = st["filtered"]["start_m"] * 1e6 if st["filtered"] else None
         row.update({f"fspread_{k}": v for k, v in st["last_window_spreads"]["filtered"].items()})
         row.update({f"spread_{k}": v for k, v in st["last_window_spreads"]["cycles"].items()})

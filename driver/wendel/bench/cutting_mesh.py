@@ -14,10 +14,9 @@ the work over the travel), ``*_spread`` the spread (max - min) / mean of the rem
 edge at the same step and with the same edge at the other step: ``(F_c - F_c_ref) / F_c_ref``.
 
 ``cutting-steady``: r/2 cut 1.2 mm on a longer block: do the remesh-cycle means settle; ``cutting-fbar``: r/2 with F-bar
-(``cutting.volumetric = "fbar"``) against the same without it; ``cutting-steady-fbar``: ``cutting-steady`` with F-bar.
-
-Each case is written to ``results/bench/work/cutting-mesh/<case>/``; a folder holding the finished cut of the same
-scene (``cutting.csv``, ``summary.json``, that ``scene.resolved.json``) is read, not run again (8-25 minutes a case)."""
+(``cutting.volumetric = "fbar"``) against the same without it; ``cutting-steady-fbar``: ``cutting-steady`` with F-bar. Each
+case is written to ``results/bench/work/cutting-mesh/<case>/``; a folder holding the finished cut of the same scene
+(``cutting.csv``, ``summary.json``, that ``scene.resolved.json``) is read, not run again (8-25 minutes a case)."""
 
 from __future__ import annotations
 
@@ -75,8 +74,7 @@ def measure(rows: list[dict], window: float = WINDOW) -> dict:
     """The last ``window`` [m] of travel of a cut's ``cutting.csv`` rows (see the module)."""
     from ..cutting.fe_steady import SERIES, cycle_means
     t = np.array([r["tool_travel_m"] for r in rows])
-    hi = t[-1]
-    lo = hi - window
+    hi, lo = t[-1], t[-1] - window
     w = np.diff(t, prepend=0.0)                     # the travel each row covers (0 for a re-equilibration)
     inc = (t > lo + 1e-12) & (w > 1e-12)
     cyc = [c for c in cycle_means(rows) if c["tool_travel_m"] > lo]
@@ -197,16 +195,16 @@ def cutting_steady_bench(quick: bool, workdir: Path) -> list[dict]:
     ``cutting.snap_to_tool`` (folder ``...-snap``); ``WENDEL_BENCH_CONDUCTION=1``: with heat conduction and
     frictional heat (``thermal.coupling = "staggered"``, as ``cutting-heat``; folder ``...-conduction``);
     ``WENDEL_BENCH_EDGE``: the edge size r / that whole number (2-8; folder ``r<n>-...``) instead of r/2;
-    ``WENDEL_BENCH_MUMPS=1``: MUMPS as the direct solver (``numerics.direct``; folder ``...-mumps``)."""
+    ``WENDEL_BENCH_MUMPS=1``: MUMPS as the direct solver (``numerics.direct``; folder ``...-mumps``);
+    ``WENDEL_BENCH_UNTIL_STEADY=1``: the cut ends at its steady state (``cutting.stop_when_steady``, ``...-until-steady``)."""
     return _steady(quick, workdir, "cell")
 
 
 @register("cutting-steady-fbar")
 def cutting_steady_fbar_bench(quick: bool, workdir: Path) -> list[dict]:
     """``cutting-steady`` with F-bar (``cutting.volumetric = "fbar"``): the same 1.2 mm cut at edge r/2, its
-    own folder and rows (an hour or more on one core; ``--quick``: 400 um; ``WENDEL_BENCH_EDGE``: another edge, as
-    ``cutting-steady``). ``WENDEL_BENCH_REMESH_EVERY``: remesh
-    after that many increments instead of the scene's 8 (folder ``r2-long-remeshN``; session 14: 6 reaches 1.2 mm);
+    own folder and rows (an hour or more on one core; ``--quick``: 400 um; the other settings as ``cutting-steady``).
+    ``WENDEL_BENCH_REMESH_EVERY``: remesh after that many increments instead of the scene's 8 (folder ``r2-long-remeshN``);
     ``WENDEL_BENCH_CUT_MM``: a longer cut [mm] on a block 1.4 mm longer, as ``cutting-long`` (folder
     ``r2-fbar-<um>um[-remeshN]``, with ``cutting-long``'s means over each 150 um and the last 1.5 mm)."""
     import os
@@ -251,6 +249,8 @@ def _steady(quick: bool, workdir: Path, vol: str, remesh_every: int | None = Non
         scene.thermal.coupling, folder = "staggered", folder + "-conduction"
     if env_flag("WENDEL_BENCH_MUMPS", 'numerics.direct = "mumps"'):
         scene.numerics.direct, folder = "mumps", folder + "-mumps"
+    if env_flag("WENDEL_BENCH_UNTIL_STEADY", "cutting.stop_when_steady"):
+        scene.cutting.stop_when_steady, folder = True, folder + "-until-steady"
     long = length > 1.2e-3
     length = 0.4e-3 if quick else length
     scene.geometry.model_extra["length"] = block

@@ -22,10 +22,13 @@ and record and writes ``cutting.csv`` and ``cutting.json`` in the run folder, an
   the workpiece; NaN where the record has none).
 
 ``cutting.json`` adds the Oxley prediction of the same scene (``wendel oxley``), the last increment's
-values beside it and the steady state (:mod:`wendel.cutting.fe_steady`, a window of one h of travel);
-``chip.gif`` animates every second frame. ``summary.json["outputs"]`` gets the means over the last h of travel
-(``steady_Fc_N``, ``steady_Ft_N``, ``steady_chip_m``, their cycle-mean spreads and drifts:
-:func:`wendel.cutting.fe_steady.window`), the numbers a campaign (``wendel sweep``) tabulates and plots.
+values beside it and the steady state (:mod:`wendel.cutting.fe_steady`, within ``cutting.steady_tol`` over
+``cutting.steady_length`` of travel, one h by default; ``stopped_at_steady`` where the cut ended there,
+:mod:`.fe_stop`);
+``chip.gif`` animates every second frame. ``summary.json["outputs"]`` gets the means over the last
+``cutting.steady_length`` of travel (``steady_Fc_N``, ``steady_Ft_N``, ``steady_chip_m``, their cycle-mean spreads and
+drifts: :func:`wendel.cutting.fe_steady.window`; with ``cutting.stop_when_steady`` also ``stopped_at_steady_m``), the
+numbers a campaign (``wendel sweep``) tabulates and plots.
 """
 
 from __future__ import annotations
@@ -39,8 +42,8 @@ import numpy as np
 
 from . import chip
 from .fe import MM, fe_scene, forces, tool_at_start
+from .fe_stop import FILE as STOP_FILE, length
 
-STEADY_LENGTH = 1.0    # the steady-state window: one uncut chip thickness of travel (fe_steady)
 SCENE_JSON = "cutting-scene.json"      # the cutting scene as run (report_resumed)
 COLUMNS = ["increment", "load_factor", "tool_travel_m", "Fc_N", "Ft_N", "chip_rise_m", "contact_length_m",
            "chip_thickness_m", "shear_angle_deg", "max_plastic_strain", "max_temperature_K", "max_T_primary_K",
@@ -55,10 +58,11 @@ def run_cut(scene, scene_path: Path, out: Path, smoke: bool, progress=print, fra
     """Solve the FE cut of the validated cutting ``scene`` into ``out``; report it (see the module)."""
     from ..loop.quasistatic import run_scene
     from ..scene import load
+    from .fe_stop import rule
     travel = scene.loading.steps / load(scene_path).loading.steps if smoke else 1.0
     try:
         root = Path(run_scene(fe_scene(scene, travel), scene_path, out, smoke, progress,
-                              record={SCENE_JSON: as_set(scene)}))
+                              record={SCENE_JSON: as_set(scene)}, until=rule(Path(out).resolve(), scene, progress)))
     except Exception:
         root = Path(out).resolve()
         if (root / "history.csv").is_file():       # a cut that stops: its accepted increments are reported
@@ -73,19 +77,33 @@ def run_cut(scene, scene_path: Path, out: Path, smoke: bool, progress=print, fra
     return root
 
 
+def cutting_scene(root: Path):
+    """The cutting scene of the run folder ``root`` as run (a bench or a script may have changed the file's), else
+    the file's; None for a run folder of any other scene."""
+    from ..scene import SceneError, load
+    from ..scene.schema import Scene
+    try:
+        scene = Scene.model_validate_json((root / SCENE_JSON).read_text()) if (root / SCENE_JSON).is_file() \
+            else load(root / "scene.toml")
+    except (SceneError, OSError, ValueError):
+        return None
+    return scene if getattr(scene, "cutting", None) is not None else None
+
+
+def resumed_rule(root: Path, progress=print):
+    """The stop rule (:mod:`.fe_stop`) of a cut resumed in ``root``, None for other run folders."""
+    from .fe_stop import rule
+    scene = cutting_scene(Path(root))
+    return rule(Path(root), scene, progress) if scene is not None else None
+
+
 def report_resumed(root: Path, progress=print) -> Path:
     """The cutting report of a cut that ``wendel run --resume`` finished (a sweep resumes interrupted runs so): the run
     folder's scene.toml is the cutting scene; the share of the cut (a smoke cut is its first increments) is read
     from the FE scene that was solved. Nothing for a run folder of any other scene. Returns ``root``."""
-    from ..scene import SceneError, load
-    from ..scene.schema import Scene
     root = Path(root)
-    try:       # the cutting scene as run (a bench or a script may have changed the file's), else the file's
-        scene = Scene.model_validate_json((root / SCENE_JSON).read_text()) if (root / SCENE_JSON).is_file() \
-            else load(root / "scene.toml")
-    except (SceneError, OSError, ValueError):
-        return root
-    if getattr(scene, "cutting", None) is None:
+    scene = cutting_scene(root)
+    if scene is None:
         return root
     solved = json.loads((root / "scene.resolved.json").read_text())["contact"]["path"]["x"][-1]
     travel = solved / fe_scene(scene).contact.path.x[-1]
@@ -187,13 +205,15 @@ def report(root: Path, scene, frames: bool = True, travel: float = 1.0) -> list[
                "thermal_coupling": coupling}
     if rows:
         from .fe_steady import cycle_means, gif, steady
-        summary["steady"] = steady(rows, STEADY_LENGTH * h / MM)
+        summary["steady"] = steady(rows, length(scene), c.steady_tol)
         summary["zone_temperatures"] = {"cycle_means": cycle_means(rows, ("max_T_primary_K", "max_T_secondary_K")),
                                         "zones": "primary: within 0.25 h of the shear plane, more than 0.2 h "
                                                  "from the tool; secondary: within 0.2 h of the rake face and the "
                                                  "edge, above the tip (wendel.cutting.fe_zones)"}
         if frames:
             gif(root / "frames", root / "chip.gif", every=2)
+    if (root / STOP_FILE).is_file():       # the cut ended at its steady state (cutting.stop_when_steady)
+        summary["stopped_at_steady"] = json.loads((root / STOP_FILE).read_text())
     try:
         from .scene import predict, row
         summary["oxley"] = row(predict(scene))
@@ -203,7 +223,9 @@ def report(root: Path, scene, frames: bool = True, travel: float = 1.0) -> list[
     if rows and (root / "summary.json").is_file():        # the steady figures for a campaign (wendel sweep's table)
         from .fe_steady import window
         s = json.loads((root / "summary.json").read_text())
-        s["outputs"] = {**(s.get("outputs") or {}), **window(rows, STEADY_LENGTH * h / MM)}
+        s["outputs"] = {**(s.get("outputs") or {}), **window(rows, length(scene))}
+        if c.stop_when_steady:        # where the cut ended at its steady state, NaN where it never got there
+            s["outputs"]["stopped_at_steady_m"] = summary.get("stopped_at_steady", {}).get("tool_travel_m", math.nan)
         (root / "summary.json").write_text(json.dumps(s, indent=1, default=float))
     return rows
 

@@ -15,7 +15,7 @@ import time
 from pathlib import Path
 
 from .. import freefem
-from ..cutting.fe_run import report_resumed
+from ..cutting.fe_run import report_resumed, resumed_rule
 from ..errors import DiskFull, RunFolderError
 from ..meshes import build as build_mesh
 from ..remesh import batch as remesh_batch
@@ -52,7 +52,8 @@ def run(scene_path: str | Path, smoke: bool = False, ranks: int | None = None, o
         with guarded(root):
             files, scene, state = resume_run(root, progress)
             progress(f"resuming {files.root} after increment {state.last[0]} (load factor {state.last[1]:g})")
-            return report_resumed(_execute(scene, files, state, progress), progress)     # a cut: its cutting report
+            # a cut: its stop rule (cutting.stop_when_steady) and its cutting report
+            return report_resumed(_execute(scene, files, state, progress, resumed_rule(root, progress)), progress)
     scene_path = Path(scene_path)
     scene = load(scene_path, smoke=smoke)
     if getattr(scene, "cutting", None) is not None:     # an orthogonal cut: the FE scene it derives (issue 17)
@@ -73,8 +74,10 @@ def run(scene_path: str | Path, smoke: bool = False, ranks: int | None = None, o
     return run_scene(scene, scene_path, Path(out) if out else _new_run_dir(scene_path, smoke), smoke, progress)
 
 
-def run_scene(scene: Scene, scene_path: Path, out: Path, smoke: bool = False, progress=print, record=None) -> Path:
-    """Run an already validated scene (read from ``scene_path``) into ``out`` (``record``: write_provenance's)."""
+def run_scene(scene: Scene, scene_path: Path, out: Path, smoke: bool = False, progress=print, record=None,
+              until=None) -> Path:
+    """Run an already validated scene (read from ``scene_path``) into ``out`` (``record``: write_provenance's;
+    ``until``: a stop rule, asked with the state after every launch that ended well, as :func:`solve`)."""
     files = RunFiles(Path(out).resolve())      # FreeFEM runs inside the run folder: paths must be absolute
     if files.root.is_dir() and any(files.root.iterdir()):
         # never mix a new run with the files of another (nor delete them): a new folder, or --resume
@@ -101,10 +104,10 @@ def run_scene(scene: Scene, scene_path: Path, out: Path, smoke: bool = False, pr
         state = State(pending=scene.loading.load_factors())
         state.mesh_seconds, dimension = build(scene, files)
         _save_checkpoint(files, scene, state, dimension)
-        return _execute(scene, files, state, progress)
+        return _execute(scene, files, state, progress, until)
 
 
-def _execute(scene: Scene, files: RunFiles, state: State, progress) -> Path:
+def _execute(scene: Scene, files: RunFiles, state: State, progress, until=None) -> Path:
     """Solve the pending increments, then summary and picture."""
     dimension = json.loads(files.checkpoint.read_text())["dimension"]
     overlap.preload("meshio")         # a resumed run
@@ -112,11 +115,12 @@ def _execute(scene: Scene, files: RunFiles, state: State, progress) -> Path:
     progress(f"  run folder {files.root}")
     # the picture process starts its renderer while FreeFEM solves
     with pictures.painter(pictures.renderer(files.mesh)) if scene.output.png else contextlib.nullcontext() as painter:
-        _solve_and_report(scene, files, state, dimension, progress, painter)
+        _solve_and_report(scene, files, state, dimension, progress, painter, until)
     return files.root
 
 
-def _solve_and_report(scene: Scene, files: RunFiles, state: State, dimension: int, progress, painter) -> None:
+def _solve_and_report(scene: Scene, files: RunFiles, state: State, dimension: int, progress, painter,
+                      until=None) -> None:
     """Solve, write summary.json, then the picture (the run's critical path waits for the render only)."""
     try:
         segment = state.segments[-1]
@@ -125,7 +129,7 @@ def _solve_and_report(scene: Scene, files: RunFiles, state: State, dimension: in
                 and not after_reequilibration:
             maybe_remesh(scene, files, state, dimension, progress)    # a run resumed before the decision
         separated.maybe_switch(scene, files, state, dimension, progress)     # (the same, DG -> CG)
-        solve(scene, files, state, dimension, progress)
+        solve(scene, files, state, dimension, progress, until)
         separation.after_run(scene, files, state, progress)
     finally:
         with contextlib.suppress(OSError):       # a full disk must not hide why the run stopped
@@ -138,21 +142,11 @@ def _solve_and_report(scene: Scene, files: RunFiles, state: State, dimension: in
                           scene.output.warp, deformed=scene.kinematics.updated_lagrangian)
         else:            # no VTU series: the picture is made from a VTU of the last increment that is not kept
             with tempfile.TemporaryDirectory() as tmp:
-                _write_increment_vtu(files, state, dimension, inc, Path(tmp) / "last.vtu",
-                                     scene.kinematics.updated_lagrangian)
+                vtu.write_increment(Path(tmp) / "last.vtu", files.root / state.segment(inc)["mesh"],
+                                    files.fem / f"inc-{inc:04d}", dimension, scene.kinematics.updated_lagrangian)
                 painter.paint(Path(tmp) / "last.vtu", files.root / "deformed.png", f"load factor {lf:g}",
                               scene.output.warp, deformed=scene.kinematics.updated_lagrangian)
         summary.write_summary(files.root, scene, state, dimension, picture=time.perf_counter() - t0)
-
-
-def _write_increment_vtu(files: RunFiles, state: State, dimension: int, inc: int, path: Path,
-                         updated_lagrangian: bool = False) -> None:
-    """The VTU of accepted increment ``inc`` at ``path``."""
-    points, cells = vtu.read_mesh(files.root / state.segment(inc)["mesh"], dimension)
-    pdata, cdata = vtu.increment_fields(files.fem / f"inc-{inc:04d}", len(points), len(cells), dimension)
-    if updated_lagrangian:      # the VTU is the deformed body itself (points = current positions)
-        points = vtu.current_points(pdata, points)
-    vtu.write_vtu(path, points, cells, dimension, pdata, cdata)
 
 
 def build(scene: Scene, files: RunFiles) -> tuple[float, int]:
@@ -168,9 +162,10 @@ def build(scene: Scene, files: RunFiles) -> tuple[float, int]:
     return time.perf_counter() - t0, dimension
 
 
-def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress) -> None:
+def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress, until=None) -> None:
     """Launch FreeFEM on the pending increments (all in one launch without remeshing; with it, a launch a remeshing
-    segment, ended by FreeFEM after a poor mesh: :mod:`wendel.remesh.batch`); cut failing steps; remesh."""
+    segment, ended by FreeFEM after a poor mesh: :mod:`wendel.remesh.batch`); cut failing steps; remesh. After a
+    launch that ended well ``until(state)`` (if given) may end the run: the increments left are dropped."""
     write_tables(scene, files, dimension)
     if scene.remesh:            # imported while FreeFEM solves the first segment, not at the first remesh
         overlap.preload("wendel.remesh.transfer", "wendel.remesh.mesher")
@@ -230,6 +225,8 @@ def solve(scene: Scene, files: RunFiles, state: State, dimension: int, progress)
             cut_step(scene, files, state, failure, progress, dimension)
             _save_checkpoint(files, scene, state, dimension)
             continue
+        if until is not None and until(state):         # e.g. a cut at its steady state (wendel.cutting.fe_stop)
+            state.pending.clear()
         if scene.loading.adaptive and not was_reequilibration:
             grow_step(scene, state, files)
         if scene.remesh and state.pending and not (was_reequilibration

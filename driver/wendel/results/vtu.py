@@ -200,3 +200,13 @@ def read_pvd(path: Path) -> list[tuple[float, Path]]:
     """The (time, VTU path) entries of a PVD file."""
     root = ET.parse(path).getroot()
     return [(float(d.get("timestep")), path.parent / d.get("file")) for d in root.iter("DataSet")]
+
+
+def write_increment(path: Path, mesh: Path, inc_dir: Path, dimension: int, updated_lagrangian: bool = False) -> None:
+    """The VTU at ``path`` of an accepted increment: its mesh file ``mesh``, its FreeFEM folder ``inc_dir``
+    (updated-Lagrangian: the VTU is the deformed body itself, its points the current positions)."""
+    points, cells = read_mesh(mesh, dimension)
+    pdata, cdata = increment_fields(inc_dir, len(points), len(cells), dimension)
+    if updated_lagrangian:
+        points = current_points(pdata, points)
+    write_vtu(path, points, cells, dimension, pdata, cdata)

@@ -113,6 +113,14 @@ class Cutting(BaseModel):
     snap_to_tool: bool = Field(False, description="FE: the remeshes move new boundary nodes that fall inside the "
                                "tool (on old edges of the machined surface that cut its rounded edge: 1.3-3.4 um "
                                "deep on the F-bar steel cut, measured) onto its surface, as remesh.snap_to_tool")
+    steady_tol: float = Field(0.02, gt=0, le=1, description="FE: the steady state is where F_c, F_t and the chip "
+                              "thickness (their remesh-cycle means) stay within this relative spread over "
+                              "steady_length of travel [1] (wendel.cutting.fe_steady)")
+    steady_length: Optional[float] = Field(None, gt=0, description="FE: the travel over which the steady state is "
+                                           "judged [m]; default: one uncut_thickness")
+    stop_when_steady: bool = Field(False, description="FE: end the cut at the end of the remesh cycle where the "
+                                   "steady state is first found (cut_length is then the most the tool travels); "
+                                   "cutting.json's stopped_at_steady says where")
     oxley: OxleyConstants = OxleyConstants()
 
     @model_validator(mode="after")
