@@ -208,10 +208,12 @@ def test_a_resumed_report_reads_the_cutting_scene_as_run(tmp_path):
     assert (root / "cutting.csv").read_text() == before
 
 
-def test_a_cut_that_asks_ends_at_its_steady_state_and_says_where(tmp_path):
+@pytest.mark.parametrize("measure, span", [("cycles", 30e-6), ("filtered", 20e-6)])
+def test_a_cut_that_asks_ends_at_its_steady_state_and_says_where(tmp_path, measure, span):
     """cutting.stop_when_steady: the loop asks wendel.cutting.fe_stop after each launch (a remesh cycle); the cut
     ends at the end of the first cycle where the cycle means of F_c, F_t and chip thickness have stayed within
-    cutting.steady_tol over cutting.steady_length (loose here: 20 % over 30 um, found at about 110 um of the 200)."""
+    cutting.steady_tol over cutting.steady_length (loose here: 20 % over 30 um, found at about 110 um of the 200),
+    or with steady_measure = "filtered" their running means over 20 um within 20 % over 40 um (about 110 um too)."""
     from wendel.cutting.fe_run import resumed_rule
     from wendel.cutting.fe_steady import steady
     from wendel.loop.checkpoint import load_state
@@ -219,7 +221,8 @@ def test_a_cut_that_asks_ends_at_its_steady_state_and_says_where(tmp_path):
     scene = load(STEEL, smoke=True)
     scene.geometry.model_extra["length"] = 1.4e-3
     scene.cutting.cut_length, scene.loading.steps, scene.cutting.remesh_every = 0.2e-3, 40, 4
-    scene.cutting.stop_when_steady, scene.cutting.steady_tol, scene.cutting.steady_length = True, 0.2, 30e-6
+    scene.cutting.stop_when_steady, scene.cutting.steady_tol, scene.cutting.steady_length = True, 0.2, span
+    scene.cutting.steady_measure = measure
     said = []
     root = run_cut(scene, STEEL, tmp_path / "cut", smoke=False, progress=said.append, frames=False)
     rows = [{k: float(v) for k, v in r.items()} for r in csv.DictReader((root / "cutting.csv").open())]
@@ -231,12 +234,12 @@ def test_a_cut_that_asks_ends_at_its_steady_state_and_says_where(tmp_path):
     assert summary["outputs"]["stopped_at_steady_m"] == stop["tool_travel_m"]
     assert stop["tool_travel_m"] == pytest.approx(rows[-1]["tool_travel_m"])
     # the report's steady state (the same tolerance and length) is the window the loop stopped on ...
-    assert cut["steady"]["cycles"] == stop["window"] and cut["steady"]["tol"] == 0.2
-    assert stop["window"]["end_m"] - stop["window"]["start_m"] >= 30e-6 * (1 - 1e-9)
+    assert cut["steady"][measure] == stop["window"] and cut["steady"]["tol"] == 0.2 and stop["measure"] == measure
+    assert stop["window"]["end_m"] - stop["window"]["start_m"] >= span * (1 + (measure == "filtered")) * (1 - 1e-9)
     assert max(stop["window"]["spreads"].values()) <= 0.2 and stop["check_seconds"] > 0
     # ... and it was not there one launch earlier: the rows before the last remesh cycle have no window
     last_reeq = max(k for k in range(1, len(rows)) if rows[k]["tool_travel_m"] == rows[k - 1]["tool_travel_m"])
-    assert steady(rows[:last_reeq], 30e-6, 0.2)["cycles"] is None
+    assert steady(rows[:last_reeq], span, 0.2)[measure] is None
     assert any("cutting.stop_when_steady" in s for s in said)
     # resumed: nothing left to cut; the resumed loop gets the same rule, which finds the same window at once
     history = (root / "history.csv").read_text()

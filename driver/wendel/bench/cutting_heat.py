@@ -125,7 +125,9 @@ def cutting_ti_bench(quick: bool, workdir: Path) -> list[dict]:
     ``cutting.volumetric = "fbar"`` (folder ``...-fbar``), 0 or unset: as the scene says (the P1 cell's own).
     ``WENDEL_BENCH_CONDUCTION=1``: heat conduction and frictional heat (``thermal.coupling = "staggered"``, folder
     ``...-conduction``); ``WENDEL_BENCH_MUMPS=1``: MUMPS (``...-mumps``); ``WENDEL_BENCH_UNTIL_STEADY=1``: the cut ends
-    at its steady state (``cutting.stop_when_steady``, ``...-until-steady``), ``steady_at_s`` its wall time there."""
+    at its steady state (``cutting.stop_when_steady``, ``...-until-steady``), ``steady_at_s`` its wall time there;
+    ``WENDEL_BENCH_STEADY_MEASURE=filtered``: that state judged on the running means (``cutting.steady_measure``,
+    folder ``...-filtered``; ``steady_*`` then that measure's window)."""
     import os
 
     from ..cutting.scene import predict
@@ -155,6 +157,11 @@ def cutting_ti_bench(quick: bool, workdir: Path) -> list[dict]:
         scene.numerics.direct, name = "mumps", name + "-mumps"
     if env_flag("WENDEL_BENCH_UNTIL_STEADY", "cutting.stop_when_steady"):
         scene.cutting.stop_when_steady, name = True, name + "-until-steady"
+    measure = os.environ.get("WENDEL_BENCH_STEADY_MEASURE", "cycles")
+    if measure not in ("cycles", "filtered"):
+        raise ValueError(f"WENDEL_BENCH_STEADY_MEASURE = {measure!r}: cycles (the default) or filtered")
+    if measure == "filtered":
+        scene.cutting.steady_measure, name = measure, name + "-filtered"
     row = _case("staggered" if conduction else "adiabatic", quick, workdir, scene=scene, scene_path=path, name=name)
     if mm is not None and not quick:
         import csv
@@ -163,11 +170,12 @@ def cutting_ti_bench(quick: bool, workdir: Path) -> list[dict]:
         cut = [{k: float(v) for k, v in r.items()} for r in csv.DictReader((workdir / name / "cutting.csv").open())]
         st = steady(cut, scene.cutting.uncut_thickness)
         row["steady_from_um"] = st["cycles"]["start_m"] * 1e6 if st["cycles"] else None
-        row["steady_to_um"] = st["cycles"]["end_m"] * 1e6 if st["cycles"] else None
-        row["steady_at_s"] = reached(workdir / name, cut, st["cycles"])
+        found = st[measure]
+        row["steady_to_um"] = found["end_m"] * 1e6 if found else None
+        row["steady_at_s"] = reached(workdir / name, cut, found)
         row["travel_um"] = cut[-1]["tool_travel_m"] * 1e6
-        row.update({f"steady_{k}": v for k, v in (st["cycles"] or {}).get("values", {}).items()})
-        row.update({f"steady_spread_{k}": v for k, v in (st["cycles"] or {}).get("spreads", {}).items()})
+        row.update({f"steady_{k}": v for k, v in (found or {}).get("values", {}).items()})
+        row.update({f"steady_spread_{k}": v for k, v in (found or {}).get("spreads", {}).items()})
         row["filtered_from_um"] = st["filtered"]["start_m"] * 1e6 if st["filtered"] else None
         row.update({f"fspread_{k}": v for k, v in st["last_window_spreads"]["filtered"].items()})
         row.update({f"spread_{k}": v for k, v in st["last_window_spreads"]["cycles"].items()})

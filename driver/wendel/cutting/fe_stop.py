@@ -5,7 +5,9 @@ F-bar cut's steady window closed at 2,089 um, 36.4 of its 40.2 minutes). With ``
 quasi-static loop asks :class:`SteadyStop` after every launch that ended well (a launch is a remesh cycle: the
 increments from one remesh to the next) whether the remesh-cycle means of F_c, F_t and the chip thickness have
 stayed within ``cutting.steady_tol`` over ``cutting.steady_length`` of travel (the ``cycles`` measure of
-:mod:`wendel.cutting.fe_steady`, the one the report gives first). If so the loop drops the increments left and
+:mod:`wendel.cutting.fe_steady`, the one the report gives first; ``cutting.steady_measure = "filtered"``: its running
+means over that length within the tolerance over twice it, the dynamometer's view that a remesh-to-remesh scatter of
+F_t does not hide, as on the titanium cut). If so the loop drops the increments left and
 the run ends as a completed run; ``steady-stop.json`` in the run folder says where and why, and the report copies
 it into ``cutting.json`` (``stopped_at_steady``). The cut is the same as without the stop up to there: the
 check only reads the accepted increments (their VTU, once each: an increment's row is kept by the VTU's
@@ -34,7 +36,7 @@ class SteadyStop:
         c = scene.cutting
         self.root, self.progress, self.width = Path(root), progress, c.width
         self.h, self.rake = c.uncut_thickness * MM, math.radians(c.rake)
-        self.length, self.tol = length(scene), c.steady_tol
+        self.length, self.tol, self.measure = length(scene), c.steady_tol, c.steady_measure
         extra = fe_scene(scene).geometry.model_extra
         self.tip0 = np.array(tool_at_start(c, extra["length"] - extra["pre_cut"])["tip"])
         self.rows: dict[int, tuple] = {}         # increment -> (VTU identity, row)
@@ -42,20 +44,26 @@ class SteadyStop:
 
     def __call__(self, state) -> bool:
         """True when the cut has reached its steady state (and ``steady-stop.json`` is written)."""
-        from .fe_steady import _detect, cycle_means
+        from .fe_steady import _detect, cycle_means, running_means
         t0 = time.perf_counter()
         rows = self._rows()
-        found = _detect(cycle_means(rows), self.length, self.tol) if rows else None
+        if not rows:
+            found = None
+        elif self.measure == "filtered":         # the running means over one length, within tol over two
+            found = _detect(running_means(rows, self.length), 2 * self.length, self.tol)
+        else:
+            found = _detect(cycle_means(rows), self.length, self.tol)
         self.seconds += time.perf_counter() - t0
         if found:
             last = rows[-1]
             stop = {"increment": int(last["increment"]), "tool_travel_m": last["tool_travel_m"],
-                    "window": found, "length_m": self.length, "tol": self.tol,
+                    "window": found, "measure": self.measure, "length_m": self.length, "tol": self.tol,
                     "increments_left": len(state.pending), "check_seconds": self.seconds}
             (self.root / FILE).write_text(json.dumps(stop, indent=1))
             v = found["values"]
+            what = "running means" if self.measure == "filtered" else "cycle means"
             self.progress(f"  steady from {found['start_m'] * 1e6:.0f} to {found['end_m'] * 1e6:.0f} um of travel "
-                          f"(cycle means within {self.tol:.0%}): F_c {v['Fc_N']:.4g} N, F_t {v['Ft_N']:.4g} N, "
+                          f"({what} within {self.tol:.0%}): F_c {v['Fc_N']:.4g} N, F_t {v['Ft_N']:.4g} N, "
                           f"chip {v['chip_thickness_m'] * 1e6:.4g} um; the cut ends at "
                           f"{last['tool_travel_m'] * 1e6:.0f} um (cutting.stop_when_steady)")
         state.post_seconds += time.perf_counter() - t0

@@ -118,6 +118,11 @@ class Cutting(BaseModel):
                               "steady_length of travel [1] (wendel.cutting.fe_steady)")
     steady_length: Optional[float] = Field(None, gt=0, description="FE: the travel over which the steady state is "
                                            "judged [m]; default: one uncut_thickness")
+    steady_measure: Literal["cycles", "filtered"] = Field("cycles", description="FE: what stop_when_steady asks of "
+                                                          "the cut: the remesh-cycle means within steady_tol over "
+                                                          "steady_length (cycles), or the running means over "
+                                                          "steady_length within it over twice that (filtered: a "
+                                                          "dynamometer's view, blind to the remesh-to-remesh scatter)")
     stop_when_steady: bool = Field(False, description="FE: end the cut at the end of the remesh cycle where the "
                                    "steady state is first found (cut_length is then the most the tool travels); "
                                    "cutting.json's stopped_at_steady says where")
