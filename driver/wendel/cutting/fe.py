@@ -66,6 +66,9 @@ SMOOTH_FBAR = 0.25
 EDGE_ZONE = 2.0   # graded remesh (cutting.edge_size): the edge box reaches 2 edge radii from the edge's centre
 GROWTH = 0.3      # ... the size grows by 0.3 per unit distance outside a zone
 FAR = 2.0         # ... and is 2 geometry.fine * geometry.h far from the tool
+# gmsh may take this long to mesh the deformed body (remesh.mesh_timeout; a cut's remesh takes 0.1-0.2 s, measured;
+# session 27: the titanium cut's remesh 162 hung in gmsh for 11 minutes), then the next gmsh 2D algorithm meshes it
+MESH_TIMEOUT = 60.0
 
 
 def tool_at_start(cutting, x_step: float) -> dict:
@@ -146,7 +149,7 @@ def fe_scene(scene, travel: float = 1.0) -> Scene:
     # uniform size fine * h (graded on p down to half of it at the edge, the isothermal cut stopped at 40 um
     # instead of 92.5, measured: "mesh would invert" after the second remesh)
     remesh = {"at": at, "indicator": "", "h": fine * g.h * MM, "max_remeshes": len(at) + 20,
-              "relax_steps": RELAX_STEPS, "relax_tol": c.relax_tol, "first_step": first}
+              "relax_steps": RELAX_STEPS, "relax_tol": c.relax_tol, "first_step": first, "mesh_timeout": MESH_TIMEOUT}
     smooth = c.smooth_features if c.smooth_features is not None else (SMOOTH_FBAR if c.volumetric == "fbar" else 0.0)
     if smooth > 0:
         remesh["smooth_features"] = smooth

@@ -47,15 +47,21 @@ def drop_last_remesh(state, pending: list | None = None) -> dict:
     return rep
 
 
-def made_or_failed(remesh, k: int, inc: int, lf: float, quality: dict, root):
-    """``remesh()`` (remesh ``k`` after increment ``inc``), its failure to make a mesh of the deformed body (gmsh's
-    own errors, numpy's "need at least one array to concatenate" on an empty mesh) turned into a
-    :class:`wendel.errors.RemeshFailure` (a run failure, exit 1) that names the remesh, the increment and its element
-    ``quality`` and says what to do; a full disk stays what it is."""
-    try:
-        return remesh()
-    except OSError:
-        raise
-    except Exception as exc:
-        from ..errors import RemeshFailure
-        raise RemeshFailure.at(k, inc, lf, quality, root, exc) from exc
+def made_or_failed(remesh, k: int, inc: int, lf: float, quality: dict, root, tries: list = (None,),
+                   progress=print) -> tuple[dict, int]:
+    """``remesh(algorithm)`` (remesh ``k`` after increment ``inc``) with each gmsh 2D algorithm of ``tries`` in turn
+    (None: gmsh's default) until one makes a mesh of the deformed body; the report and the index of the one that did.
+    When none does (gmsh's own errors, a :class:`wendel.remesh.limit.MeshTimeout`, numpy's "need at least one array
+    to concatenate" on an empty mesh), a :class:`wendel.errors.RemeshFailure` (a run failure, exit 1) that names the
+    remesh, the increment and its element ``quality`` and says what to do; a full disk stays what it is."""
+    for i, algorithm in enumerate(tries):
+        try:
+            return remesh(algorithm), i
+        except OSError:
+            raise
+        except Exception as exc:
+            if i + 1 == len(tries):
+                from ..errors import RemeshFailure
+                raise RemeshFailure.at(k, inc, lf, quality, root, exc) from exc
+            progress(f"  remesh {k}: {type(exc).__name__}: {exc}; meshing with gmsh algorithm {tries[i + 1]}")
+    raise ValueError("made_or_failed: no gmsh algorithm to try")

@@ -15,8 +15,7 @@ it is too poor (or the scene asks for a remesh at that increment), gmsh meshes t
   other state files (``*.txt``) are copied.
 
 The driver then re-equilibrates at the same load factor before the next increment; the transfer report
-(``remesh/remesh-K.json``) records the residual before and after, the change of the integral and extrema of p,
-the quality before and after, and the times.
+(``remesh/remesh-K.json``) records the residuals, the change of the integral and extrema of p, the qualities, the times.
 """
 
 from __future__ import annotations
@@ -34,8 +33,7 @@ import numpy as np
 from .again import AGAIN, made_or_failed
 from .batch import first_steps
 from .snap import onto_tool, tool_at, zones_at       # the tool where it stands at a remesh (numpy only)
-from . import quality       # mesher (meshio, gmsh) and transfer (scipy) when a run remeshes: a run without
-                            # remeshing judges its mesh only and does not pay their imports
+from . import limit, quality   # mesher (meshio, gmsh), transfer (scipy) when a run remeshes: one that does not: none
 from ..results import vtu
 
 SKIP_NODE = {"u", "u_total"}
@@ -284,14 +282,16 @@ def maybe_remesh(scene, files, state, dimension: int, progress, again: int = 0, 
     ubase_old = vtu.read_array(files.root / seg["ubase"]) if seg["ubase"] else None
     why = " (the next step failed)" if failed else " (asked by remesh.at)" if not poor else ""
     progress(f"  increment {inc}: min quality {q.get('min_quality', float('nan')):.3g}{why}: remeshing")
-    rep = made_or_failed(lambda: remesh_state(
+    tries = [None, *AGAIN][again:] if dimension == 2 else [None]       # gmsh's default, then the others in turn
+    rep, used = made_or_failed(lambda algorithm: remesh_state(
         files.fem / f"inc-{inc:04d}", files.root / seg["mesh"], ubase_old, dimension, files.root / mesh_new,
         files.root / state_dir, h, r.h_min or h / 3, r.indicator, mu=scene.material.E / (2 * (1 + scene.material.nu)),
         axisymmetric=scene.elasticity.plane == "axisymmetric", zones=zones_at(r, files.fem / f"inc-{inc:04d}"),
-        algorithm_2d=AGAIN[again - 1] if again else None, smooth_features=r.smooth_features,
-        tool=tool_at(scene, files.fem / f"inc-{inc:04d}") if r.snap_to_tool else None), k, inc, lf, q, files.root)
+        algorithm_2d=algorithm, smooth_features=r.smooth_features, make_mesh=limit.mesher(r.mesh_timeout),
+        tool=tool_at(scene, files.fem / f"inc-{inc:04d}") if r.snap_to_tool else None), k, inc, lf, q, files.root,
+        tries, progress)
     rep.update({"remesh": k, "after_increment": inc, "load_factor": lf, "dimension": dimension,
-                "algorithm_2d_tries": again, "after_failed_step": failed,
+                "algorithm_2d_tries": again + used, "after_failed_step": failed,
                 "first_steps": first_steps(scene, lf, state.pending)})      # (drop_last_remesh takes them out)
     state.remeshes.append(rep)
     state.segments.append({"first": inc + 1, "mesh": mesh_new, "ubase": f"{state_dir}/ubase.txt",

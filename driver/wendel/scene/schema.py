@@ -317,6 +317,10 @@ class Remesh(Strict):
     snap_to_tool: bool = Field(False, description="2D with a polygon tool (contact.tool): the new mesh's boundary "
                                "nodes that fall inside the tool (on old boundary edges that cut its rounded corner) "
                                "are moved onto its surface before the transfer (wendel.remesh.snap)")
+    mesh_timeout: Optional[float] = Field(None, gt=0, description="seconds gmsh may take to mesh a deformed body: "
+                                          "it then meshes in a worker process, stopped after that long, and the body "
+                                          "is meshed with the next gmsh 2D algorithm (wendel.remesh.limit); default: "
+                                          "gmsh in the driver's process, no limit")
     zones_follow: Literal["body", "tool"] = Field("body", description="body: the zones stand where they are "
                                                   "written; tool: they move with contact.path (written for "
                                                   "the tool at load factor 0)")
