@@ -42,7 +42,7 @@ import numpy as np
 
 from . import chip
 from .fe import MM, fe_scene, forces, tool_at_start
-from .fe_stop import FILE as STOP_FILE, length
+from .fe_stop import FILE as STOP_FILE, length, rule
 
 SCENE_JSON = "cutting-scene.json"      # the cutting scene as run (report_resumed)
 COLUMNS = ["increment", "load_factor", "tool_travel_m", "Fc_N", "Ft_N", "chip_rise_m", "contact_length_m",
@@ -58,7 +58,6 @@ def run_cut(scene, scene_path: Path, out: Path, smoke: bool, progress=print, fra
     """Solve the FE cut of the validated cutting ``scene`` into ``out``; report it (see the module)."""
     from ..loop.quasistatic import run_scene
     from ..scene import load
-    from .fe_stop import rule
     travel = scene.loading.steps / load(scene_path).loading.steps if smoke else 1.0
     try:
         root = Path(run_scene(fe_scene(scene, travel), scene_path, out, smoke, progress,
@@ -92,7 +91,6 @@ def cutting_scene(root: Path):
 
 def resumed_rule(root: Path, progress=print):
     """The stop rule (:mod:`.fe_stop`) of a cut resumed in ``root``, None for other run folders."""
-    from .fe_stop import rule
     scene = cutting_scene(Path(root))
     return rule(Path(root), scene, progress) if scene is not None else None
 

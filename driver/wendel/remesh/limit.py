@@ -35,7 +35,7 @@ while True:
     try:
         result = (True, mesher.remesh(*args, **kwargs))
     except Exception as e:
-        result = (False, f"{type(e).__name__}: {e}")
+        result = (False, str(e) if type(e) is ValueError else f"{type(e).__name__}: {e}")
     pickle.dump(result, answer)
     answer.flush()
 """
@@ -57,8 +57,12 @@ class Worker:
             env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p))     # the driver's code
             self.proc = subprocess.Popen([sys.executable, "-c", _WORKER], stdin=subprocess.PIPE,
                                          stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, env=env)
-        pickle.dump((args, kwargs), self.proc.stdin)
-        self.proc.stdin.flush()
+        try:
+            pickle.dump((args, kwargs), self.proc.stdin)
+            self.proc.stdin.flush()
+        except BrokenPipeError:         # the worker died since its last mesh: not a full disk (an OSError too)
+            self.close()
+            raise RuntimeError("the remesh worker process had ended (gmsh crashed?)") from None
         if not select.select([self.proc.stdout], [], [], self.timeout)[0]:
             self.close()
             raise MeshTimeout(f"gmsh did not mesh the deformed body within remesh.mesh_timeout = {self.timeout:g} s "
