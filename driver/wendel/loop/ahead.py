@@ -16,16 +16,13 @@ from __future__ import annotations
 import json
 import os
 import subprocess
-import sys
 from pathlib import Path
 
+from ..remesh.limit import gmsh_worker
+
 _WORKER = r"""
-import json, os, sys
+import json
 from pathlib import Path
-answer = os.fdopen(os.dup(1), "w", buffering=1)      # the protocol; gmsh's C++ side prints to fd 1: away
-null = os.open(os.devnull, os.O_WRONLY)
-os.dup2(null, 1)
-os.close(null)
 from wendel.meshes import drilling as geometry
 for line in sys.stdin:
     job = json.loads(line)
@@ -59,9 +56,7 @@ class Builder:
         self.asked.add(str(path))
         try:
             if self.proc is None:
-                env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p))   # the driver's code
-                self.proc = subprocess.Popen([sys.executable, "-c", _WORKER], stdin=subprocess.PIPE,
-                                             stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, env=env)
+                self.proc = gmsh_worker(_WORKER, text=True)
             self.proc.stdin.write(json.dumps({"kind": kind, "path": str(path), "kwargs": kwargs}) + "\n")
             self.proc.stdin.flush()
             self.pending.append(str(path))

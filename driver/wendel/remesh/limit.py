@@ -20,12 +20,16 @@ import select
 import subprocess
 import sys
 
-_WORKER = r"""
-import os, pickle, sys
-answer = os.fdopen(os.dup(1), "wb")       # the protocol; gmsh's C++ side prints to fd 1: away
+_QUIET = r"""
+import os, sys
+answer = os.fdopen(os.dup(1), "{mode}", buffering={buffering})      # the protocol; gmsh prints to fd 1
 null = os.open(os.devnull, os.O_WRONLY)
 os.dup2(null, 1)
 os.close(null)
+"""
+
+_WORKER = r"""
+import pickle
 from wendel.remesh import mesher
 while True:
     try:
@@ -41,6 +45,16 @@ while True:
 """
 
 
+def gmsh_worker(body: str, text: bool = False) -> subprocess.Popen:
+    """A fresh interpreter running ``body`` (Python source) on the driver's code, its requests on stdin, gmsh's
+    output to fd 1 sent to /dev/null and its answers written to ``answer`` (the process's stdout; text or
+    binary; text answers are line-buffered); stderr to /dev/null. Also the drilling loop's mesh worker (:class:`wendel.loop.ahead.Builder`)."""
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p))      # the driver's code
+    code = _QUIET.format(mode="w" if text else "wb", buffering=1 if text else -1) + body
+    return subprocess.Popen([sys.executable, "-c", code], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                            stderr=subprocess.DEVNULL, text=text, env=env)
+
+
 class MeshTimeout(RuntimeError):
     """gmsh did not mesh the body within the time limit (not an OSError: a full disk is told apart)."""
 
@@ -54,9 +68,7 @@ class Worker:
 
     def __call__(self, *args, **kwargs) -> dict:
         if self.proc is None or self.proc.poll() is not None:
-            env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p))     # the driver's code
-            self.proc = subprocess.Popen([sys.executable, "-c", _WORKER], stdin=subprocess.PIPE,
-                                         stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, env=env)
+            self.proc = gmsh_worker(_WORKER)
         try:
             pickle.dump((args, kwargs), self.proc.stdin)
             self.proc.stdin.flush()
