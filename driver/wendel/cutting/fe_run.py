@@ -146,14 +146,29 @@ def measure(points: np.ndarray, cells: np.ndarray, state: np.ndarray, tip: np.nd
     return {"chip_rise": rise, "contact_length": max(length, 0.0), "chip_thickness": thickness}
 
 
+def tool_start(scene, fe=None) -> dict:
+    """The tool of the cutting ``scene`` at load factor 0 (:func:`wendel.cutting.fe.tool_at_start` in front of the
+    step of its FE scene ``fe``, by default ``fe_scene(scene)``)."""
+    extra = (fe or fe_scene(scene)).geometry.model_extra
+    return tool_at_start(scene.cutting, extra["length"] - extra["pre_cut"])
+
+
+def measured(rec: dict, m, tip0: np.ndarray, rake: float, h: float, width: float) -> tuple:
+    """One increment's tool shift [mm], :func:`measure` and forces F_c, F_t [N] from its history record ``rec`` and
+    its VTU ``m`` (meshio; the tool's tip at load factor 0 ``tip0``, the uncut thickness ``h`` in mm)."""
+    shift = np.array([float(rec.get("tool_x") or 0.0), float(rec.get("tool_y") or 0.0)])
+    got = measure(m.points[:, :2], m.cells_dict["triangle"], np.asarray(m.point_data["friction_state"]).ravel(),
+                  tip0 + shift, rake, h)
+    return shift, got, *forces(rec, width)
+
+
 def report(root: Path, scene, frames: bool = True, travel: float = 1.0) -> list[dict]:
     """Per-increment cutting outputs of the run folder ``root`` (see the module); returns the rows."""
     import meshio
     c = scene.cutting
     h, rake = c.uncut_thickness * MM, math.radians(c.rake)
     fe = fe_scene(scene, travel)
-    extra = fe.geometry.model_extra
-    start = tool_at_start(c, extra["length"] - extra["pre_cut"])
+    start = tool_start(scene, fe)
     tip0 = np.array(start["tip"])
     history = list(csv.DictReader((root / "history.csv").open()))
     from .fe_frames import rounded_outline
@@ -173,9 +188,7 @@ def report(root: Path, scene, frames: bool = True, travel: float = 1.0) -> list[
         m = meshio.read(vtu_path)
         points = m.points[:, :2]
         cells = m.cells_dict["triangle"]
-        shift = np.array([float(rec.get("tool_x") or 0.0), float(rec.get("tool_y") or 0.0)])
-        got = measure(points, cells, np.asarray(m.point_data["friction_state"]).ravel(), tip0 + shift, rake, h)
-        fc, ft = forces(rec, c.width)
+        shift, got, fc, ft = measured(rec, m, tip0, rake, h, c.width)
         t2 = got["chip_thickness"]
         phi = chip.shear_angle(h, t2, rake) if t2 == t2 and t2 > 0 else float("nan")
         temps = zone_temperatures(m, outline0 + shift, tip0 + shift, rake, h, phi if phi == phi else phi_oxley)

@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .fe import MM, fe_scene, forces, tool_at_start
+from .fe import MM
 
 FILE = "steady-stop.json"
 
@@ -37,8 +37,8 @@ class SteadyStop:
         self.root, self.progress, self.width = Path(root), progress, c.width
         self.h, self.rake = c.uncut_thickness * MM, math.radians(c.rake)
         self.length, self.tol, self.measure = length(scene), c.steady_tol, c.steady_measure
-        extra = fe_scene(scene).geometry.model_extra
-        self.tip0 = np.array(tool_at_start(c, extra["length"] - extra["pre_cut"])["tip"])
+        from .fe_run import tool_start
+        self.tip0 = np.array(tool_start(scene)["tip"])
         self.rows: dict[int, tuple] = {}         # increment -> (VTU identity, row)
         self.seconds = 0.0                       # the checks' own time (also in the run's driver output phase)
 
@@ -73,7 +73,7 @@ class SteadyStop:
         """F_c, F_t, chip thickness and travel of every accepted increment so far (cutting.csv's)."""
         import meshio
 
-        from .fe_run import measure
+        from .fe_run import measured
         out = []
         with (self.root / "history.csv").open() as f:
             history = list(csv.DictReader(f))
@@ -86,11 +86,7 @@ class SteadyStop:
                 continue
             key = (st.st_mtime_ns, st.st_size)
             if self.rows.get(inc, (None,))[0] != key:
-                m = meshio.read(path)
-                shift = np.array([float(rec.get("tool_x") or 0.0), float(rec.get("tool_y") or 0.0)])
-                got = measure(m.points[:, :2], m.cells_dict["triangle"],
-                              np.asarray(m.point_data["friction_state"]).ravel(), self.tip0 + shift, self.rake, self.h)
-                fc, ft = forces(rec, self.width)
+                shift, got, fc, ft = measured(rec, meshio.read(path), self.tip0, self.rake, self.h, self.width)
                 self.rows[inc] = (key, {"increment": inc, "tool_travel_m": -shift[0] / MM, "Fc_N": fc, "Ft_N": ft,
                                         "chip_thickness_m": got["chip_thickness"] / MM})
             out.append(self.rows[inc][1])
