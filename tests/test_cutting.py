@@ -37,6 +37,20 @@ def test_oxley_reproduces_the_published_aisi1045_case(steel):
     assert steel.seconds < 2.0
 
 
+def test_oxley_agrees_with_another_implementation_at_the_measured_cuts_of_200_m_per_min():
+    """The file that transcribes the measured AISI 1045 cuts (wendel.cutting.experiments) also gives its own
+    Oxley implementation's forces and chip at each: at 200 m/min (h = 0.15, 0.30 mm, rake -7, +5 deg) ours is
+    within 1 % in F_c and 5 % in F_t and the chip (at 400 m/min the two take different delta, README)."""
+    from wendel.bench.oxley import measured_aisi1045
+    rows = [r for r in measured_aisi1045(load(STEEL)) if r["V_m_per_min"] == 200]
+    assert len(rows) == 4
+    for r in rows:
+        assert abs(r["Fc"] / r["Fc_other_oxley"] - 1) < 0.01, r
+        assert abs(r["Ft"] / r["Ft_other_oxley"] - 1) < 0.05, r
+        assert abs(r["chip_mm"] / r["chip_other_oxley_mm"] - 1) < 0.05, r
+        assert r["Fc"] < r["Fc_measured"] and r["Ft"] < r["Ft_measured"]     # the model's known miss, thrust most
+
+
 def test_the_scene_gives_the_same_inputs_as_the_paper(steel):
     mat, th, cut, opt = inputs(load(STEEL))
     assert mat == oxley.AISI1045_LALWANI and th == oxley.AISI1045_LALWANI_THERMAL

@@ -20,7 +20,7 @@ from typing import Callable
 from ..loop import RESULTS
 
 BENCHES: dict[str, Callable[[bool, Path], list[dict]]] = {}
-OPT_IN = {"step42-dealii", "step42-pair", "step42-accuracy", "meshcache", "ranks", "overhead", "gmsh3d", "cutting", "cutting-isothermal", "cutting-mesh", "cutting-fbar", "cutting-steady", "cutting-steady-fbar", "cutting-steady-mesh", "direct", "cutting-levers", "cutting-paths", "cutting-long", "cutting-heat", "cutting-ti", "cutting-kienzle", "drilling-3d", "necking-fine", "sweep-warm"}
+OPT_IN = {"step42-dealii", "step42-pair", "step42-accuracy", "meshcache", "ranks", "overhead", "gmsh3d", "cutting", "cutting-adiabatic", "cutting-isothermal", "cutting-mesh", "cutting-fbar", "cutting-steady", "cutting-steady-fbar", "cutting-steady-mesh", "direct", "cutting-levers", "cutting-paths", "cutting-long", "cutting-heat", "cutting-ti", "cutting-kienzle", "drilling-3d", "necking-fine", "sweep-warm"}
 """Run only when named: deal.II's step-42 needs extra Debian packages and 8 minutes; ``overhead`` runs
 every scene (twice with WENDEL_BENCH_BASE); the FE cuts take about 4 minutes each, the whole 3D deep bore (``drilling-3d``) about 7, the finer and remeshed necking bars (``necking-fine``) about 3."""
 

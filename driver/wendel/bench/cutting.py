@@ -1,13 +1,18 @@
-"""``wendel bench cutting`` and ``cutting-isothermal``: the FE cut of the AISI 1045 scene, adiabatic (as the
-scene says) and isothermal (the same scene with its heating off).
+"""``wendel bench cutting``: the steel and the titanium cut to their steady state, as their scenes say
+(``workflows/cutting-aisi1045-steady.toml``, ``workflows/cutting-ti6al4v-steady.toml``: F-bar, conduction and
+frictional heat, edge r/2, MUMPS, ``cutting.stop_when_steady``), one after the other (about 36 and 16 minutes
+on one core; ``--quick``: each scene's first 20 increments, no steady state). Per cut: where it ended and why,
+the steady window (its start and end, F_c, F_t and chip thickness with their spreads), the run's wall time
+(``summary.json``: up to the stop, Python's start and the report excepted) and the bench's (with the report and
+its frames), the shares of the run's wall time in remeshing + transfer and in failed tries (increments whose
+step was cut, launches that kept none), Newton iterations and remeshes, beside the Oxley prediction of the same
+scene and the differences.
 
-Each case runs ``workflows/cutting-aisi1045.toml`` (``--quick``: its first 20 increments) through
+``cutting-adiabatic`` and ``cutting-isothermal``: the prototype steel scene ``workflows/cutting-aisi1045.toml``
+as written (P1 cells, adiabatic, 0.6 mm) and without its heating. Each case runs through
 :func:`wendel.cutting.fe_run.run_cut`; a run that stops (Newton failure after the step cuts) is reported as
-far as it got, with the reason. Per case: increments and tool travel reached, F_c and F_t at the end and
-their mean over the last 20 um of travel, the chip rise, contact length and chip thickness, the largest
-plastic strain (and temperature), the wall time and the share of remeshing + transfer, beside the Oxley
-prediction of the same scene. ``WENDEL_BENCH_FBAR``: 1 or 0 sets ``cutting.volumetric`` (``"fbar"``, ``"cell"``)
-instead of the scene's.
+far as it got, with the reason. ``WENDEL_BENCH_FBAR``: 1 or 0 sets ``cutting.volumetric`` (``"fbar"``,
+``"cell"``) instead of the scene's (``cutting-adiabatic``, ``cutting-isothermal``).
 """
 
 from __future__ import annotations
@@ -68,9 +73,67 @@ def _rows(out: Path) -> list[dict]:
     return [{k: float(v) for k, v in r.items()} for r in csv.DictReader((out / "cutting.csv").open())]
 
 
+STEADY = (("steel", "cutting-aisi1045-steady.toml"), ("titanium", "cutting-ti6al4v-steady.toml"))
+
+
+def _to_steady(name: str, scene_path: Path, workdir: Path, quick: bool) -> dict:
+    from ..cutting.experiments import reference
+    from ..cutting.fe_run import run_cut
+    from ..cutting.scene import predict
+    from ..errors import StepCutError
+    from ..freefem import FreeFemError, NewtonFailure
+    from ..scene import load
+
+    scene = load(scene_path)
+    if quick:
+        scene.cutting.cut_length *= 20 / scene.loading.steps
+        scene.loading.steps = 20
+    out = workdir / name
+    shutil.rmtree(out, ignore_errors=True)          # the bench's own folder of an earlier run
+    t0, stopped = time.perf_counter(), ""
+    try:
+        run_cut(scene, scene_path, out, smoke=False, progress=lambda *_: None, frames=True)
+    except (NewtonFailure, StepCutError, FreeFemError) as exc:
+        stopped = str(exc).split(";")[0]
+    bench_wall = time.perf_counter() - t0
+    rows, s = _rows(out), json.loads((out / "summary.json").read_text())
+    wall, ph = s["wall_time"], s["wall_time_by_phase"]
+    stop = json.loads((out / "steady-stop.json").read_text()) if (out / "steady-stop.json").is_file() else None
+    win = stop["window"] if stop else {}
+    v, sp = win.get("values", {}), win.get("spreads", {})
+    ox = predict(scene)
+    nan = float("nan")
+    fc, ft, chip = v.get("Fc_N", nan), v.get("Ft_N", nan), v.get("chip_thickness_m", nan) * 1e6
+    c = scene.cutting
+    exp = reference(name, c.speed * 60, c.uncut_thickness * 1e3, c.rake) or {}
+    same_width = exp.get("width_mm") is not None and abs(exp["width_mm"] - c.width * 1e3) < 1e-9
+    efc, eft = (exp["Fc_N"], exp["Ft_N"]) if same_width else (nan, nan)     # totals only at the scene's width
+    return {"case": name, "scene": scene_path.name, "steady": stop is not None,
+            "measure": scene.cutting.steady_measure, "ended_um": rows[-1]["tool_travel_m"] * 1e6,
+            "increments": s["increments"], "steady_from_um": win.get("start_m", nan) * 1e6,
+            "steady_to_um": win.get("end_m", nan) * 1e6, "Fc_N": fc, "Ft_N": ft, "chip_um": chip,
+            "h_ratio": chip / (scene.cutting.uncut_thickness * 1e6),
+            **{f"spread_{k}": sp.get(k, nan) for k in ("Fc_N", "Ft_N", "chip_thickness_m")},
+            "wall_s": wall, "bench_wall_s": bench_wall, "remesh_share": ph.get("remesh", 0.0) / wall,
+            "failed_share": (ph.get("failed_increments", 0.0) + ph.get("failed_launches", 0.0)) / wall,
+            "newton_iterations": s["newton_iterations"], "remeshes": len(s["remeshes"]), "step_cuts": s["step_cuts"],
+            "oxley_Fc_N": ox.Fc, "oxley_Ft_N": ox.Ft, "oxley_chip_um": ox.chip_thickness * 1e6,
+            "dFc_oxley": fc / ox.Fc - 1, "dFt_oxley": ft / ox.Ft - 1, "dchip_oxley": chip / (ox.chip_thickness * 1e6) - 1,
+            "Ft_over_Fc": ft / fc, "oxley_Ft_over_Fc": ox.Ft / ox.Fc,
+            "exp_Fc_N": efc, "exp_Ft_N": eft, "dFc_exp": fc / efc - 1, "dFt_exp": ft / eft - 1,
+            "exp_Ft_over_Fc": exp.get("Ft_over_Fc", nan), "exp_h_ratio": exp.get("h_ratio") or nan,
+            "experiment": exp.get("source", "none at these conditions"), "stopped": stopped}
+
+
 @register("cutting")
 def cutting_bench(quick: bool, workdir: Path) -> list[dict]:
-    """The scene as written (adiabatic); ``cutting-isothermal`` is the same cut without heating (each ~15 min)."""
+    """The steel and the titanium scene cut to their steady state (see the module; about 52 minutes, quick 2)."""
+    return [_to_steady(name, WORKFLOWS / path, workdir, quick) for name, path in STEADY]
+
+
+@register("cutting-adiabatic")
+def cutting_adiabatic_bench(quick: bool, workdir: Path) -> list[dict]:
+    """The prototype scene as written (adiabatic); ``cutting-isothermal`` is the same cut without heating (each ~15 min)."""
     return [_case("adiabatic", WORKFLOWS / "cutting-aisi1045.toml", workdir, 20 if quick else None)]
 
 

@@ -3,7 +3,10 @@
 ``oxley``: the extended Oxley model on the published AISI 1045 case (Lalwani et al. 2009) with each
 choice of where the secondary zone's k and c are taken, against the two published implementations'
 range, with the wall time of a solve; and the model at the four conditions of the NIST AISI 1045
-tests (Ivester et al. 2000: V = 200, 300 m/min; h = 0.15, 0.30 mm; rake -7 deg; b = 1.6 mm).
+tests (Ivester et al. 2000: V = 200, 300 m/min; h = 0.15, 0.30 mm; rake -7 deg; b = 1.6 mm); and the model
+against the eight measured AISI 1045 cuts of :data:`wendel.cutting.experiments.AISI1045` (V = 200, 400 m/min,
+h = 0.15, 0.30 mm, rake -7, +5 deg: their measured F_c and F_t, the differences, and the transcribing file's own
+Oxley implementation at each).
 
 ``oxley-kienzle``: Oxley over speed x uncut chip thickness x rake for the AISI 1045 and Ti-6Al-4V
 scenes, Kienzle's k_c1.1 and m_c fitted per (speed, rake) and per rake, beside catalogue values.
@@ -64,6 +67,24 @@ def oxley_bench(quick: bool, workdir: Path) -> list[dict]:
                      "h_mm": h, "Fc": r.Fc, "Ft": r.Ft, "chip_mm": r.chip_thickness * 1e3,
                      "T_int_C": r.T_int - 273.15, "phi_deg": math.degrees(r.phi), "C0": r.C0, "delta": r.delta,
                      "evaluations": r.evaluations, "ms": r.seconds * 1e3})
+    rows += measured_aisi1045(scene)
+    return rows
+
+
+def measured_aisi1045(scene) -> list[dict]:
+    """Oxley at each measured AISI 1045 cut of :data:`wendel.cutting.experiments.AISI1045` (the scene's material,
+    width and options, the cut's V, h and rake) against its measured F_c and F_t, with the differences."""
+    from ..cutting import oxley
+    from ..cutting.experiments import AISI1045, AISI1045_MODEL, AISI1045_SOURCE
+    from ..cutting.scene import inputs
+    rows = []
+    for e, (fc, ft, chip) in zip(AISI1045, AISI1045_MODEL):
+        r = oxley.predict(*inputs(scene, speed=e.V / 60, uncut=e.h * 1e-3, rake=e.rake))
+        rows.append({"case": "measured AISI 1045 cut", "V_m_per_min": e.V, "h_mm": e.h, "rake_deg": e.rake,
+                     "Fc": r.Fc, "Ft": r.Ft, "chip_mm": r.chip_thickness * 1e3, "T_int_C": r.T_int - 273.15,
+                     "Fc_measured": e.Fc, "Ft_measured": e.Ft, "dFc_measured": r.Fc / e.Fc - 1,
+                     "dFt_measured": r.Ft / e.Ft - 1, "Fc_other_oxley": fc, "Ft_other_oxley": ft,
+                     "chip_other_oxley_mm": chip, "source": AISI1045_SOURCE})
     return rows
 
 
