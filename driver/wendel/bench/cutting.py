@@ -1,7 +1,8 @@
 """``wendel bench cutting``: the steel and the titanium cut to their steady state, as their scenes say
 (``workflows/cutting-aisi1045-steady.toml``, ``workflows/cutting-ti6al4v-steady.toml``: F-bar, conduction and
 frictional heat, edge r/2, MUMPS, ``cutting.stop_when_steady``), one after the other (about 36 and 16 minutes
-on one core; ``--quick``: each scene's first 20 increments, no steady state). Per cut: where it ended and why,
+on one core; ``--quick``: each scene's first 20 increments, no steady state; ``WENDEL_BENCH_CASES``,
+``WENDEL_BENCH_RAKE``, ``WENDEL_BENCH_SPEED``: one of them, another rake or speed). Per cut: where it ended and why,
 the steady window (its start and end, F_c, F_t and chip thickness with their spreads), the run's wall time
 (``summary.json``: up to the stop, Python's start and the report excepted) and the bench's (with the report and
 its frames), the shares of the run's wall time in remeshing + transfer and in failed tries (increments whose
@@ -88,7 +89,13 @@ def _to_steady(name: str, scene_path: Path, workdir: Path, quick: bool) -> dict:
     if quick:
         scene.cutting.cut_length *= 20 / scene.loading.steps
         scene.loading.steps = 20
-    out = workdir / name
+    folder = name
+    rake, speed = _number("WENDEL_BENCH_RAKE", -20.0, 30.0), _number("WENDEL_BENCH_SPEED", 20.0, 1000.0)
+    if rake is not None:
+        scene.cutting.rake, folder = rake, f"{folder}-rake{rake:g}"
+    if speed is not None:
+        scene.cutting.speed, folder = speed / 60.0, f"{folder}-V{speed:g}"
+    out = workdir / folder
     shutil.rmtree(out, ignore_errors=True)          # the bench's own folder of an earlier run
     t0, stopped = time.perf_counter(), ""
     try:
@@ -108,7 +115,8 @@ def _to_steady(name: str, scene_path: Path, workdir: Path, quick: bool) -> dict:
     exp = reference(name, c.speed * 60, c.uncut_thickness * 1e3, c.rake) or {}
     same_width = exp.get("width_mm") is not None and abs(exp["width_mm"] - c.width * 1e3) < 1e-9
     efc, eft = (exp["Fc_N"], exp["Ft_N"]) if same_width else (nan, nan)     # totals only at the scene's width
-    return {"case": name, "scene": scene_path.name, "steady": stop is not None,
+    return {"case": folder, "scene": scene_path.name, "rake_deg": c.rake, "V_m_per_min": c.speed * 60,
+            "steady": stop is not None,
             "measure": scene.cutting.steady_measure, "ended_um": rows[-1]["tool_travel_m"] * 1e6,
             "increments": s["increments"], "steady_from_um": win.get("start_m", nan) * 1e6,
             "steady_to_um": win.get("end_m", nan) * 1e6, "Fc_N": fc, "Ft_N": ft, "chip_um": chip,
@@ -125,10 +133,34 @@ def _to_steady(name: str, scene_path: Path, workdir: Path, quick: bool) -> dict:
             "experiment": exp.get("source", "none at these conditions"), "stopped": stopped}
 
 
+def _number(var: str, lo: float, hi: float) -> float | None:
+    """A number from the environment variable ``var`` in [lo, hi], None if unset; anything else refused by name."""
+    import math
+    import os
+    v = os.environ.get(var)
+    if v is None:
+        return None
+    try:
+        x = float(v)
+    except ValueError:
+        x = math.nan
+    if not lo <= x <= hi:
+        raise ValueError(f"{var} = {v!r}: a number from {lo:g} to {hi:g}")
+    return x
+
+
 @register("cutting")
 def cutting_bench(quick: bool, workdir: Path) -> list[dict]:
-    """The steel and the titanium scene cut to their steady state (see the module; about 52 minutes, quick 2)."""
-    return [_to_steady(name, WORKFLOWS / path, workdir, quick) for name, path in STEADY]
+    """The steel and the titanium scene cut to their steady state (see the module; about 52 minutes, quick 6).
+    ``WENDEL_BENCH_CASES``: the cuts to make (``steel``, ``titanium``, comma-separated; both if unset);
+    ``WENDEL_BENCH_RAKE`` [deg], ``WENDEL_BENCH_SPEED`` [m/min]: that rake or cutting speed instead of the scene's
+    (folders ``<case>-rake<deg>``, ``<case>-V<speed>``; the measured cut at those conditions, if any, beside it)."""
+    import os
+    wanted = [c for c in os.environ.get("WENDEL_BENCH_CASES", "").split(",") if c]
+    unknown = sorted(set(wanted) - {name for name, _ in STEADY})
+    if unknown:
+        raise ValueError(f"WENDEL_BENCH_CASES = {','.join(wanted)!r}: {', '.join(unknown)} unknown; valid: steel, titanium")
+    return [_to_steady(name, WORKFLOWS / path, workdir, quick) for name, path in STEADY if not wanted or name in wanted]
 
 
 @register("cutting-adiabatic")
