@@ -126,7 +126,8 @@ def _to_steady(name: str, scene_path: Path, workdir: Path, quick: bool) -> dict:
             "failed_share": (ph.get("failed_increments", 0.0) + ph.get("failed_launches", 0.0)) / wall,
             "newton_iterations": s["newton_iterations"], "remeshes": len(s["remeshes"]), "step_cuts": s["step_cuts"],
             "oxley_Fc_N": ox.Fc, "oxley_Ft_N": ox.Ft, "oxley_chip_um": ox.chip_thickness * 1e6,
-            "dFc_oxley": fc / ox.Fc - 1, "dFt_oxley": ft / ox.Ft - 1, "dchip_oxley": chip / (ox.chip_thickness * 1e6) - 1,
+            "dFc_oxley": fc / ox.Fc - 1, "dFt_oxley": ft / ox.Ft - 1,
+            "dchip_oxley": chip / (ox.chip_thickness * 1e6) - 1,
             "Ft_over_Fc": ft / fc, "oxley_Ft_over_Fc": ox.Ft / ox.Fc,
             "exp_Fc_N": efc, "exp_Ft_N": eft, "dFc_exp": fc / efc - 1, "dFt_exp": ft / eft - 1,
             "exp_Ft_over_Fc": exp.get("Ft_over_Fc", nan), "exp_h_ratio": exp.get("h_ratio") or nan,
@@ -159,13 +160,15 @@ def cutting_bench(quick: bool, workdir: Path) -> list[dict]:
     wanted = [c for c in os.environ.get("WENDEL_BENCH_CASES", "").split(",") if c]
     unknown = sorted(set(wanted) - {name for name, _ in STEADY})
     if unknown:
-        raise ValueError(f"WENDEL_BENCH_CASES = {','.join(wanted)!r}: {', '.join(unknown)} unknown; valid: steel, titanium")
+        raise ValueError(f"WENDEL_BENCH_CASES = {','.join(wanted)!r}: {', '.join(unknown)} unknown; "
+                         "valid: steel, titanium")
     return [_to_steady(name, WORKFLOWS / path, workdir, quick) for name, path in STEADY if not wanted or name in wanted]
 
 
 @register("cutting-adiabatic")
 def cutting_adiabatic_bench(quick: bool, workdir: Path) -> list[dict]:
-    """The prototype scene as written (adiabatic); ``cutting-isothermal`` is the same cut without heating (each ~15 min)."""
+    """The prototype scene as written (adiabatic); ``cutting-isothermal`` is the same cut without heating
+    (each ~15 min)."""
     return [_case("adiabatic", WORKFLOWS / "cutting-aisi1045.toml", workdir, 20 if quick else None)]
 
 

@@ -21,8 +21,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-AISI1045_SOURCE = "Lalwani et al. 2009's experimental columns, qingfengxia/quasi_static_metal_cutting validation.csv @ 98b37712"
-TI6AL4V_SOURCE = "Klippel et al. 2024, tests V0438-V0440, alexsouza1989/ToolWearPredictor-LIME-SHAP ti_dataset.csv @ 2e3ed29"
+AISI1045_SOURCE = ("Lalwani et al. 2009's experimental columns, "
+                   "qingfengxia/quasi_static_metal_cutting validation.csv @ 98b37712")
+TI6AL4V_SOURCE = ("Klippel et al. 2024, tests V0438-V0440, "
+                  "alexsouza1989/ToolWearPredictor-LIME-SHAP ti_dataset.csv @ 2e3ed29")
 
 
 @dataclass(frozen=True)
