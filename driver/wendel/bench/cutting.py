@@ -78,9 +78,7 @@ STEADY = (("steel", "cutting-aisi1045-steady.toml"), ("titanium", "cutting-ti6al
 
 
 def _to_steady(name: str, scene_path: Path, workdir: Path, quick: bool) -> dict:
-    from ..cutting.experiments import reference
     from ..cutting.fe_run import run_cut
-    from ..cutting.scene import predict
     from ..errors import StepCutError
     from ..freefem import FreeFemError, NewtonFailure
     from ..scene import load
@@ -102,7 +100,16 @@ def _to_steady(name: str, scene_path: Path, workdir: Path, quick: bool) -> dict:
         run_cut(scene, scene_path, out, smoke=False, progress=lambda *_: None, frames=True)
     except (NewtonFailure, StepCutError, FreeFemError) as exc:
         stopped = str(exc).split(";")[0]
-    bench_wall = time.perf_counter() - t0
+    return row(folder, scene, scene_path, out, time.perf_counter() - t0, stopped)
+
+
+def row(case: str, scene, scene_path: Path, out: Path, bench_wall: float, stopped: str) -> dict:
+    """The bench's row of the cut ``scene`` in the run folder ``out`` (see the module); ``first_<measure>_*``: the
+    first window of each steady measure (:func:`wendel.cutting.fe_steady.steady`) whether or not the run stopped
+    there, ``last_cycles_spread_*``: the remesh-cycle means' spreads over the last window."""
+    from ..cutting.experiments import reference
+    from ..cutting.fe_steady import steady
+    from ..cutting.scene import predict
     rows, s = _rows(out), json.loads((out / "summary.json").read_text())
     wall, ph = s["wall_time"], s["wall_time_by_phase"]
     stop = json.loads((out / "steady-stop.json").read_text()) if (out / "steady-stop.json").is_file() else None
@@ -112,10 +119,21 @@ def _to_steady(name: str, scene_path: Path, workdir: Path, quick: bool) -> dict:
     nan = float("nan")
     fc, ft, chip = v.get("Fc_N", nan), v.get("Ft_N", nan), v.get("chip_thickness_m", nan) * 1e6
     c = scene.cutting
-    exp = reference(name, c.speed * 60, c.uncut_thickness * 1e3, c.rake) or {}
+    st = steady(rows, c.uncut_thickness)
+    first = {}
+    for m in ("cycles", "filtered"):
+        w = st[m] or {}
+        first.update({f"first_{m}_from_um": w.get("start_m", nan) * 1e6, f"first_{m}_to_um": w.get("end_m", nan) * 1e6,
+                      **{f"first_{m}_{k}": w.get("values", {}).get(k, nan) for k in ("Fc_N", "Ft_N")},
+                      f"first_{m}_chip_um": w.get("values", {}).get("chip_thickness_m", nan) * 1e6,
+                      **{f"first_{m}_spread_{k}": w.get("spreads", {}).get(k, nan)
+                         for k in ("Fc_N", "Ft_N", "chip_thickness_m")}})
+    first.update({f"last_cycles_spread_{k}": v for k, v in st["last_window_spreads"]["cycles"].items()})
+    material = "titanium" if "ti6al4v" in scene_path.name else "steel"
+    exp = reference(material, c.speed * 60, c.uncut_thickness * 1e3, c.rake) or {}
     same_width = exp.get("width_mm") is not None and abs(exp["width_mm"] - c.width * 1e3) < 1e-9
     efc, eft = (exp["Fc_N"], exp["Ft_N"]) if same_width else (nan, nan)     # totals only at the scene's width
-    return {"case": folder, "scene": scene_path.name, "rake_deg": c.rake, "V_m_per_min": c.speed * 60,
+    return {"case": case, "scene": scene_path.name, "rake_deg": c.rake, "V_m_per_min": c.speed * 60,
             "steady": stop is not None,
             "measure": scene.cutting.steady_measure, "ended_um": rows[-1]["tool_travel_m"] * 1e6,
             "increments": s["increments"], "steady_from_um": win.get("start_m", nan) * 1e6,
@@ -131,7 +149,7 @@ def _to_steady(name: str, scene_path: Path, workdir: Path, quick: bool) -> dict:
             "Ft_over_Fc": ft / fc, "oxley_Ft_over_Fc": ox.Ft / ox.Fc,
             "exp_Fc_N": efc, "exp_Ft_N": eft, "dFc_exp": fc / efc - 1, "dFt_exp": ft / eft - 1,
             "exp_Ft_over_Fc": exp.get("Ft_over_Fc", nan), "exp_h_ratio": exp.get("h_ratio") or nan,
-            "experiment": exp.get("source", "none at these conditions"), "stopped": stopped}
+            "experiment": exp.get("source", "none at these conditions"), **first, "stopped": stopped}
 
 
 def _number(var: str, lo: float, hi: float) -> float | None:
