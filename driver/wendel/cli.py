@@ -90,7 +90,7 @@ def main(argv: list[str] | None = None) -> int:
                    "  overhead, gmsh3d, meshcache (the ball with a cold and a warm mesh cache, about 3 minutes),\n"
                    "  sweep-warm (20 smoke runs of a local sweep, forked warm and as fresh interpreters, about 2 minutes),\n"
                    "  ranks (the ball on 1 and 2 PETSc ranks, interleaved, about 4 minutes),\n"
-                   "  cutting (the steel and the titanium cut to their steady state, about 52 minutes),\n"
+                   "  cutting (the steel and the titanium cut to their steady state, about 55 minutes),\n"
                    "  cutting-adiabatic, cutting-isothermal (the prototype steel cut, about 15 minutes each),\n"
                    "  cutting-mesh (the FE cut at 3 edge resolutions and 2 steps, about an hour), cutting-fbar,\n"
                    "  cutting-steady (the FE cut to 1.2 mm, about 10-15 minutes), cutting-steady-fbar (the same with F-bar),\n"

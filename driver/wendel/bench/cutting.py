@@ -170,7 +170,7 @@ def _number(var: str, lo: float, hi: float) -> float | None:
 
 @register("cutting")
 def cutting_bench(quick: bool, workdir: Path) -> list[dict]:
-    """The steel and the titanium scene cut to their steady state (see the module; about 52 minutes, quick 6).
+    """The steel and the titanium scene cut to their steady state (see the module; about 55 minutes alone, quick 6).
     ``WENDEL_BENCH_CASES``: the cuts to make (``steel``, ``titanium``, comma-separated; both if unset);
     ``WENDEL_BENCH_RAKE`` [deg], ``WENDEL_BENCH_SPEED`` [m/min]: that rake or cutting speed instead of the scene's
     (folders ``<case>-rake<deg>``, ``<case>-V<speed>``; the measured cut at those conditions, if any, beside it)."""
