@@ -8,8 +8,8 @@ b = 1.6 mm) whose measured cutting and thrust forces Lalwani, Mehta and Jain (J.
 Gillespie, J. Mater. Process. Technol. 2019, 116389): its columns ``F_c_exp`` and ``F_t_exp`` beside the model's
 (its model columns of case 1, 576 N, 364 N, 0.43 mm, 942 C, are the published Oxley case of issue 17). The file
 names no source for the measured columns and holds no measured chip thickness (its ``chip_thickness`` is the
-model's); the conditions are those of the NIST tests (Ivester et al., Mach. Sci. Technol. 4 (2000) 511), not
-checked against either paper here.
+model's); they appear to be the NIST tests (Ivester et al., Mach. Sci. Technol. 4 (2000) 511) that Lalwani et
+al. compare with, not checked against either paper here.
 
 ``TI6AL4V``: the three dry cuts of Ti6Al4V at V = 60 m/min and h = 0.1 mm of Klippel et al. (Int. J. Adv. Manuf.
 Technol. 135 (2024) 2871; tests V0438-V0440) as transcribed in ``alexsouza1989/ToolWearPredictor-LIME-SHAP``
