@@ -100,13 +100,15 @@ def _to_steady(name: str, scene_path: Path, workdir: Path, quick: bool) -> dict:
         run_cut(scene, scene_path, out, smoke=False, progress=lambda *_: None, frames=True)
     except (NewtonFailure, StepCutError, FreeFemError) as exc:
         stopped = str(exc).split(";")[0]
-    return row(folder, scene, scene_path, out, time.perf_counter() - t0, stopped)
+    return row(folder, name, scene, scene_path, out, time.perf_counter() - t0, stopped)
 
 
-def row(case: str, scene, scene_path: Path, out: Path, bench_wall: float, stopped: str) -> dict:
-    """The bench's row of the cut ``scene`` in the run folder ``out`` (see the module); ``first_<measure>_*``: the
-    first window of each steady measure (:func:`wendel.cutting.fe_steady.steady`) whether or not the run stopped
-    there, ``last_cycles_spread_*``: the remesh-cycle means' spreads over the last window."""
+def row(case: str, material: str, scene, scene_path: Path, out: Path, bench_wall: float, stopped: str) -> dict:
+    """The bench's row of the cut ``scene`` of ``material`` (``steel``, ``titanium``: the measured cuts it is
+    compared with, :data:`wendel.cutting.experiments.MEASURED`) in the run folder ``out`` (see the module);
+    ``first_<measure>_*``: the first window of each steady measure (:func:`wendel.cutting.fe_steady.steady`)
+    whether or not the run stopped there, ``last_cycles_spread_*``: the remesh-cycle means' spreads over the last
+    window."""
     from ..cutting.experiments import reference
     from ..cutting.fe_steady import steady
     from ..cutting.scene import predict
@@ -129,7 +131,6 @@ def row(case: str, scene, scene_path: Path, out: Path, bench_wall: float, stoppe
                       **{f"first_{m}_spread_{k}": w.get("spreads", {}).get(k, nan)
                          for k in ("Fc_N", "Ft_N", "chip_thickness_m")}})
     first.update({f"last_cycles_spread_{k}": v for k, v in st["last_window_spreads"]["cycles"].items()})
-    material = "titanium" if "ti6al4v" in scene_path.name else "steel"
     exp = reference(material, c.speed * 60, c.uncut_thickness * 1e3, c.rake) or {}
     same_width = exp.get("width_mm") is not None and abs(exp["width_mm"] - c.width * 1e3) < 1e-9
     efc, eft = (exp["Fc_N"], exp["Ft_N"]) if same_width else (nan, nan)     # totals only at the scene's width

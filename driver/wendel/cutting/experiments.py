@@ -55,6 +55,10 @@ TI6AL4V = (Cut(60, 0.1, 0, None, 211.8, 136.2), Cut(60, 0.1, 0, None, 212.3, 140
 """Rake 0 is the scene's, assumed (not read)."""
 
 
+MEASURED = {"steel": (AISI1045, AISI1045_SOURCE), "titanium": (TI6AL4V, TI6AL4V_SOURCE)}
+"""The measured cuts and their provenance by material (:func:`reference`)."""
+
+
 def matching(cuts, V: float, h: float, rake: float) -> list[Cut]:
     """The cuts at speed ``V`` [m/min], uncut chip thickness ``h`` [mm] and rake ``rake`` [deg] (to 1e-6).
 
@@ -76,10 +80,11 @@ def reference(material: str, V: float, h: float, rake: float) -> dict | None:
     >>> reference("steel", 200.0, 0.15, -7.0)["h_ratio"] is None
     True
     """
-    cuts = matching(AISI1045 if material == "steel" else TI6AL4V, V, h, rake)
+    table, source = MEASURED[material]
+    cuts = matching(table, V, h, rake)
     if not cuts:
         return None
     fc, ft = sum(c.Fc for c in cuts) / len(cuts), sum(c.Ft for c in cuts) / len(cuts)
     chips = [c.chip for c in cuts if c.chip is not None]
     return {"Fc_N": fc, "Ft_N": ft, "Ft_over_Fc": ft / fc, "h_ratio": sum(chips) / len(chips) / h if chips else None,
-            "width_mm": cuts[0].width, "source": AISI1045_SOURCE if material == "steel" else TI6AL4V_SOURCE}
+            "width_mm": cuts[0].width, "source": source}
