@@ -122,6 +122,10 @@ def test_bad_zones_are_refused_with_the_key(tmp_path):
     ("cutting-paths", "WENDEL_BENCH_LEVER", "base",
      "WENDEL_BENCH_LEVER = 'base': one of newton_tol-1e-6, remesh_every-16, stages-converged, whole-first-step, "
      "lagged-softening, before-session-24, no-heat, sixteenth-first-step, 10-um-steps (cutting-levers' levers)"),
+    ("cutting", "WENDEL_BENCH_CASES", "steel,brass",
+     "WENDEL_BENCH_CASES = 'steel,brass': brass unknown; valid: steel, titanium"),
+    ("cutting", "WENDEL_BENCH_RAKE", "45", "WENDEL_BENCH_RAKE = '45': a number from -20 to 30"),
+    ("cutting", "WENDEL_BENCH_SPEED", "nan", "WENDEL_BENCH_SPEED = 'nan': a number from 20 to 1000"),
 ])
 def test_the_long_cut_benches_refuse_a_bad_setting_by_name_before_cutting(tmp_path, monkeypatch, name, var, value,
                                                                            words):
