@@ -126,6 +126,7 @@ def test_bad_zones_are_refused_with_the_key(tmp_path):
      "WENDEL_BENCH_CASES = 'steel,brass': brass unknown; valid: steel, titanium"),
     ("cutting", "WENDEL_BENCH_RAKE", "45", "WENDEL_BENCH_RAKE = '45': a number from -20 to 30"),
     ("cutting", "WENDEL_BENCH_SPEED", "nan", "WENDEL_BENCH_SPEED = 'nan': a number from 20 to 1000"),
+    ("cutting", "WENDEL_BENCH_FRICTION", "-0.1", "WENDEL_BENCH_FRICTION = '-0.1': a number from 0 to 2"),
 ])
 def test_the_long_cut_benches_refuse_a_bad_setting_by_name_before_cutting(tmp_path, monkeypatch, name, var, value,
                                                                            words):

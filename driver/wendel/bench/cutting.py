@@ -2,7 +2,8 @@
 (``workflows/cutting-aisi1045-steady.toml``, ``workflows/cutting-ti6al4v-steady.toml``: F-bar, conduction and
 frictional heat, edge r/2, MUMPS, ``cutting.stop_when_steady``), one after the other (about 36 and 16 minutes
 on one core; ``--quick``: each scene's first 20 increments, no steady state; ``WENDEL_BENCH_CASES``,
-``WENDEL_BENCH_RAKE``, ``WENDEL_BENCH_SPEED``: one of them, another rake or speed). Per cut: where it ended and why,
+``WENDEL_BENCH_RAKE``, ``WENDEL_BENCH_SPEED``, ``WENDEL_BENCH_FRICTION``: one of them, another rake, speed or
+Coulomb coefficient on the rake face). Per cut: where it ended and why,
 the steady window (its start and end, F_c, F_t and chip thickness with their spreads), the run's wall time
 (``summary.json``: up to the stop, Python's start and the report excepted) and the bench's (with the report and
 its frames), the shares of the run's wall time in remeshing + transfer and in failed tries (increments whose
@@ -93,6 +94,9 @@ def _to_steady(name: str, scene_path: Path, workdir: Path, quick: bool) -> dict:
         scene.cutting.rake, folder = rake, f"{folder}-rake{rake:g}"
     if speed is not None:
         scene.cutting.speed, folder = speed / 60.0, f"{folder}-V{speed:g}"
+    mu = _number("WENDEL_BENCH_FRICTION", 0.0, 2.0)
+    if mu is not None:
+        scene.cutting.friction, folder = mu, f"{folder}-mu{mu:g}"
     out = workdir / folder
     shutil.rmtree(out, ignore_errors=True)          # the bench's own folder of an earlier run
     t0, stopped = time.perf_counter(), ""
@@ -134,7 +138,7 @@ def row(case: str, material: str, scene, scene_path: Path, out: Path, bench_wall
     exp = reference(material, c.speed * 60, c.uncut_thickness * 1e3, c.rake) or {}
     same_width = exp.get("width_mm") is not None and abs(exp["width_mm"] - c.width * 1e3) < 1e-9
     efc, eft = (exp["Fc_N"], exp["Ft_N"]) if same_width else (nan, nan)     # totals only at the scene's width
-    return {"case": case, "scene": scene_path.name, "rake_deg": c.rake, "V_m_per_min": c.speed * 60,
+    return {"case": case, "scene": scene_path.name, "rake_deg": c.rake, "V_m_per_min": c.speed * 60, "mu": c.friction,
             "steady": stop is not None,
             "measure": scene.cutting.steady_measure, "ended_um": rows[-1]["tool_travel_m"] * 1e6,
             "increments": s["increments"], "steady_from_um": win.get("start_m", nan) * 1e6,
@@ -173,8 +177,9 @@ def _number(var: str, lo: float, hi: float) -> float | None:
 def cutting_bench(quick: bool, workdir: Path) -> list[dict]:
     """The steel and the titanium scene cut to their steady state (see the module; about 55 minutes alone, quick 6).
     ``WENDEL_BENCH_CASES``: the cuts to make (``steel``, ``titanium``, comma-separated; both if unset);
-    ``WENDEL_BENCH_RAKE`` [deg], ``WENDEL_BENCH_SPEED`` [m/min]: that rake or cutting speed instead of the scene's
-    (folders ``<case>-rake<deg>``, ``<case>-V<speed>``; the measured cut at those conditions, if any, beside it)."""
+    ``WENDEL_BENCH_RAKE`` [deg], ``WENDEL_BENCH_SPEED`` [m/min], ``WENDEL_BENCH_FRICTION`` [1]: that rake, cutting
+    speed or Coulomb coefficient instead of the scene's (folders ``<case>-rake<deg>``, ``<case>-V<speed>``,
+    ``<case>-mu<mu>``; the measured cut at that rake and speed, if any, beside it)."""
     import os
     wanted = [c for c in os.environ.get("WENDEL_BENCH_CASES", "").split(",") if c]
     unknown = sorted(set(wanted) - {name for name, _ in STEADY})
