@@ -66,6 +66,15 @@ def test_bench_help_names_every_benchmark(capsys):
     assert OPT_IN <= set(BENCHES)
 
 
+def test_bench_writes_into_the_folder_out_names(tmp_path, capsys):
+    import json
+
+    assert main(["bench", "oxley", "--quick", "--out", str(tmp_path / "b")]) == 0
+    data = json.loads((tmp_path / "b" / "oxley.json").read_text())
+    assert data["meta"]["name"] == "oxley" and data["rows"]
+    assert str(tmp_path / "b") in capsys.readouterr().out
+
+
 def test_run_prints_the_errors_against_the_reference(tmp_path, capsys):
     assert main(["run", str(ROOT / "workflows" / "smoke-mms.toml"), "--smoke", "--out", str(tmp_path / "m")]) == 0
     out = capsys.readouterr().out

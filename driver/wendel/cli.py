@@ -107,6 +107,8 @@ def main(argv: list[str] | None = None) -> int:
                    "  drilling-3d (the 3D deep bore, all 50 removal steps, about 7 minutes),\n"
                    "  necking-fine (the necking bar on a finer and on remeshed meshes, about 4 minutes)")
     p.add_argument("--quick", action="store_true", help="small sizes only")
+    p.add_argument("--out", type=Path, metavar="DIR", help="results (and work folders) into DIR instead of "
+                   "results/bench/ (two benches at once each into its own)")
 
     p = sub.add_parser("sweep", help="campaigns: a plan of runs, locally or on SLURM (see wendel.sweep)")
     from .sweep.cli import add_arguments as sweep_arguments
@@ -166,7 +168,7 @@ def main(argv: list[str] | None = None) -> int:
             return 0
         if args.command == "bench":
             from .bench import bench
-            root = bench(args.names, quick=args.quick)
+            root = bench(args.names, quick=args.quick, out=args.out)
             print(f"benchmarks written to {root}")
             return 0
     except SceneError as exc:
