@@ -90,6 +90,14 @@ def test_fe_cut_forms_a_chip(tmp_path):
     travel = [c["tool_travel_m"] for c in st["cycle_means"]]
     assert len(travel) >= 4 and all(c["increments"] >= 2 for c in st["cycle_means"]) and np.all(np.diff(travel) > 0)
     assert (root / "chip.gif").stat().st_size > 10000
+    # its Newton steps by whether they changed the contact or friction sets (wendel.cutting.fe_newton): every
+    # accepted increment's iterations counted, as summary.json counts them
+    from wendel.cutting.fe_newton import newton_sets
+    ns = newton_sets(root)
+    assert ns["increments"] == s["increments"] and ns["iterations"] == s["newton_iterations"]
+    assert ns["failed_tries"] == len(list((root / "failed-attempts").glob("*-newton.csv")))
+    assert 0 < ns["steps_counted"] <= ns["iterations"] + ns["failed_iterations"]
+    assert 0 <= ns["set_change_share"] <= 1 and ns["contraction_without"] < 1
 
 
 def test_fe_cut_compiled_residual_pass_is_the_freefem_one(tmp_path):

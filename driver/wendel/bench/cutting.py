@@ -7,7 +7,8 @@ Coulomb coefficient on the rake face). Per cut: where it ended and why,
 the steady window (its start and end, F_c, F_t and chip thickness with their spreads), the run's wall time
 (``summary.json``: up to the stop, Python's start and the report excepted) and the bench's (with the report and
 its frames), the shares of the run's wall time in remeshing + transfer and in failed tries (increments whose
-step was cut, launches that kept none), Newton iterations and remeshes, beside the Oxley prediction of the same
+step was cut, launches that kept none), Newton iterations (and how many of its steps changed the contact or
+friction sets: :func:`wendel.cutting.fe_newton.newton_sets`) and remeshes, beside the Oxley prediction of the same
 scene and the differences.
 
 ``cutting-adiabatic`` and ``cutting-isothermal``: the prototype steel scene ``workflows/cutting-aisi1045.toml``
@@ -114,6 +115,7 @@ def row(case: str, material: str, scene, scene_path: Path, out: Path, bench_wall
     whether or not the run stopped there, ``last_cycles_spread_*``: the remesh-cycle means' spreads over the last
     window."""
     from ..cutting.experiments import reference
+    from ..cutting.fe_newton import newton_sets
     from ..cutting.fe_steady import steady
     from ..cutting.scene import predict
     rows, s = _rows(out), json.loads((out / "summary.json").read_text())
@@ -148,6 +150,7 @@ def row(case: str, material: str, scene, scene_path: Path, out: Path, bench_wall
             "wall_s": wall, "bench_wall_s": bench_wall, "remesh_share": ph.get("remesh", 0.0) / wall,
             "failed_share": (ph.get("failed_increments", 0.0) + ph.get("failed_launches", 0.0)) / wall,
             "newton_iterations": s["newton_iterations"], "remeshes": len(s["remeshes"]), "step_cuts": s["step_cuts"],
+            **{k: v for k, v in newton_sets(out).items() if k not in ("increments", "iterations")},
             "oxley_Fc_N": ox.Fc, "oxley_Ft_N": ox.Ft, "oxley_chip_um": ox.chip_thickness * 1e6,
             "dFc_oxley": fc / ox.Fc - 1, "dFt_oxley": ft / ox.Ft - 1,
             "dchip_oxley": chip / (ox.chip_thickness * 1e6) - 1,

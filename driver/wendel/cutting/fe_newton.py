@@ -1,0 +1,75 @@
+"""Where an FE cut's Newton iterations go: steps after which the contact or friction sets changed, and those after
+which they did not (``python -m wendel.cutting.fe_newton RUN [RUN ...]``; a row of ``wendel bench cutting``).
+
+Each Newton step of an increment (``fem/inc-*/newton.csv``; the failed tries' ``failed-attempts/*-newton.csv``)
+solved on the sets of the iterate before it. The iterate it gives says whether those sets still hold
+(``contact_entering``, ``contact_leaving``, ``friction_changes``: nodes whose contact or stick/slip set, or slip
+direction, differ). Counted over the steps after the first of each increment (the first starts from the last
+increment's state with the tool a step further, so its contraction says little) and without the trial iterates
+that would invert a cell (their residual is 1e300): how many steps changed the sets (``set_change_share``) and
+the median contraction ``|r_k| / |r_k-1|`` of the steps that changed them and of those that did not. The
+semismooth Newton method converges fast once its sets hold; a cut whose steps mostly change them searches for
+its sets (README "Where the step cuts come from").
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import statistics
+import sys
+from pathlib import Path
+
+INVERTED = 1e200      # a residual at least this large is FreeFEM's mark of a trial that would invert a cell
+SETS = ("contact_entering", "contact_leaving", "friction_changes")     # newton.csv's counts of set changes
+
+
+def steps(path: Path) -> list[tuple[bool, float]]:
+    """(the sets changed, |r_k| / |r_k-1|) for each Newton step k >= 2 of one ``newton.csv``."""
+    rows = list(csv.DictReader(path.open()))
+    out = []
+    for a, b in zip(rows[1:], rows[2:]):
+        ra, rb = float(a["relative_residual"]), float(b["relative_residual"])
+        if not (0 < ra < INVERTED and rb < INVERTED):
+            continue
+        changed = any(int(float(b.get(k) or 0)) > 0 for k in SETS)
+        out.append((changed, rb / ra))
+    return out
+
+
+def newton_sets(root: Path) -> dict:
+    """The run folder's Newton iterations, accepted and failed, and its steps by whether they changed the sets.
+
+    The iterations are those newton.csv counts (its rows less the initial residual's), of the accepted increments
+    (``fem/inc-*``) and of the failed tries kept in ``failed-attempts/``."""
+    root = Path(root)
+    accepted = sorted(root.glob("fem/inc-*/newton.csv"))
+    failed = sorted(root.glob("failed-attempts/*-newton.csv"))
+    iters = lambda files: sum(max(sum(1 for _ in f.open()) - 2, 0) for f in files)
+    with_c, without = [], []
+    for f in accepted + failed:
+        for changed, ratio in steps(f):
+            (with_c if changed else without).append(ratio)
+    n = len(with_c) + len(without)
+    med = lambda xs: statistics.median(xs) if xs else math.nan
+    return {"increments": len(accepted), "iterations": iters(accepted), "failed_tries": len(failed),
+            "failed_iterations": iters(failed), "steps_counted": n,
+            "set_change_share": len(with_c) / n if n else math.nan,
+            "contraction_with_set_changes": med(with_c), "contraction_without": med(without)}
+
+
+def main(argv: list[str]) -> int:
+    rows = [(p, newton_sets(Path(p))) for p in argv]
+    if not rows:
+        print("usage: python -m wendel.cutting.fe_newton RUN [RUN ...]", file=sys.stderr)
+        return 2
+    keys = list(rows[0][1])
+    print("| run | " + " | ".join(keys) + " |")
+    print("|---|" + "---|" * len(keys))
+    for p, r in rows:
+        print(f"| {p} | " + " | ".join(f"{v:.3g}" if isinstance(v, float) else str(v) for v in r.values()) + " |")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
