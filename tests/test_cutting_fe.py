@@ -44,7 +44,7 @@ def test_tool_starts_in_front_of_the_step_with_its_tip_on_the_machined_level():
     assert fe.material.E == pytest.approx(scene.material.E * 1e-6)
 
 
-def test_fe_cut_forms_a_chip(tmp_path):
+def test_fe_cut_forms_a_chip(tmp_path, capsys):
     scene = load(STEEL, smoke=True)
     scene.geometry.model_extra["length"] = 1.2e-3     # m: a shorter block than the scene's (the cut is 60 um)
     scene.cutting.cut_length = 0.06e-3        # m: 12 increments of 5 um, as in the full scene
@@ -98,6 +98,15 @@ def test_fe_cut_forms_a_chip(tmp_path):
     assert ns["failed_tries"] == len(list((root / "failed-attempts").glob("*-newton.csv")))
     assert 0 < ns["steps_counted"] <= ns["iterations"] + ns["failed_iterations"]
     assert 0 <= ns["set_change_share"] <= 1 and ns["contraction_without"] < 1
+    # the bench's row of this run folder (python -m wendel.bench.cutting RUN MATERIAL): the last h's means
+    from wendel.bench.cutting import main as bench_row
+    from wendel.cutting.fe_steady import window
+    assert bench_row([str(root), "steel"]) == 0
+    said = dict(line.split(" ", 1) for line in capsys.readouterr().out.splitlines())
+    w = window([{k: float(v) for k, v in r.items()} for r in rows], h)
+    assert float(said["last_h_Fc_N"]) == pytest.approx(w["steady_Fc_N"], rel=1e-5) and said["mu"] == "0.5"
+    assert int(said["failed_tries"]) == ns["failed_tries"] and said["steady"] == "False"
+    assert bench_row([str(tmp_path), "steel"]) == 2 and bench_row([str(root), "brass"]) == 2
 
 
 def test_fe_cut_compiled_residual_pass_is_the_freefem_one(tmp_path):

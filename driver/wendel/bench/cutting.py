@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import json
 import shutil
+import sys
 import time
 from pathlib import Path
 
@@ -116,7 +117,7 @@ def row(case: str, material: str, scene, scene_path: Path, out: Path, bench_wall
     window."""
     from ..cutting.experiments import reference
     from ..cutting.fe_newton import newton_sets
-    from ..cutting.fe_steady import steady
+    from ..cutting.fe_steady import steady, window
     from ..cutting.scene import predict
     rows, s = _rows(out), json.loads((out / "summary.json").read_text())
     wall, ph = s["wall_time"], s["wall_time_by_phase"]
@@ -137,6 +138,9 @@ def row(case: str, material: str, scene, scene_path: Path, out: Path, bench_wall
                       **{f"first_{m}_spread_{k}": w.get("spreads", {}).get(k, nan)
                          for k in ("Fc_N", "Ft_N", "chip_thickness_m")}})
     first.update({f"last_cycles_spread_{k}": v for k, v in st["last_window_spreads"]["cycles"].items()})
+    last = window(rows, c.uncut_thickness)      # the last h's travel-weighted means, steady or not
+    first.update({"last_h_Fc_N": last["steady_Fc_N"], "last_h_Ft_N": last["steady_Ft_N"],
+                  "last_h_chip_um": last["steady_chip_m"] * 1e6})
     exp = reference(material, c.speed * 60, c.uncut_thickness * 1e3, c.rake) or {}
     same_width = exp.get("width_mm") is not None and abs(exp["width_mm"] - c.width * 1e3) < 1e-9
     efc, eft = (exp["Fc_N"], exp["Ft_N"]) if same_width else (nan, nan)     # totals only at the scene's width
@@ -202,3 +206,25 @@ def cutting_adiabatic_bench(quick: bool, workdir: Path) -> list[dict]:
 @register("cutting-isothermal")
 def cutting_isothermal_bench(quick: bool, workdir: Path) -> list[dict]:
     return [_case("isothermal", WORKFLOWS / "cutting-aisi1045.toml", workdir, 20 if quick else None)]
+
+
+def main(argv: list[str]) -> int:
+    """``python -m wendel.bench.cutting RUN MATERIAL``: the bench's row of a cut's run folder (a bench's work folder
+    or a ``wendel run`` of a cutting scene), as the scene was run, against the measured cuts of ``MATERIAL``
+    (``steel``, ``titanium``); one ``key value`` a line."""
+    from ..cutting.fe_run import cutting_scene
+    if len(argv) != 2 or argv[1] not in ("steel", "titanium"):
+        print("usage: python -m wendel.bench.cutting RUN steel|titanium", file=sys.stderr)
+        return 2
+    out = Path(argv[0])
+    scene = cutting_scene(out)
+    if scene is None:
+        print(f"{out}: not the run folder of a cutting scene", file=sys.stderr)
+        return 2
+    for k, v in row(out.name, argv[1], scene, out / "scene.toml", out, float("nan"), "").items():
+        print(k, f"{v:.6g}" if isinstance(v, float) else v)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
