@@ -25,8 +25,17 @@ SETS = ("contact_entering", "contact_leaving", "friction_changes")     # newton.
 
 
 def steps(path: Path) -> list[tuple[bool, float]]:
-    """(the sets changed, |r_k| / |r_k-1|) for each Newton step k >= 2 of one ``newton.csv``."""
-    rows = list(csv.DictReader(path.open()))
+    """(the sets changed, |r_k| / |r_k-1|) for each Newton step k >= 2 of one ``newton.csv``.
+
+    >>> import tempfile
+    >>> p = Path(tempfile.mkdtemp()) / "newton.csv"
+    >>> rows = ["iteration,relative_residual,friction_changes", "0,5,0", "1,0.5,2", "2,0.4,1", "3,1e-3,0", "4,1e300,3"]
+    >>> _ = p.write_text("".join(r + chr(10) for r in rows))
+    >>> steps(p)          # step 1 left out (the increment's first), step 4 too (a trial that would invert a cell)
+    [(True, 0.8), (False, 0.0025)]
+    """
+    with path.open() as f:
+        rows = list(csv.DictReader(f))
     out = []
     for a, b in zip(rows[1:], rows[2:]):
         ra, rb = float(a["relative_residual"]), float(b["relative_residual"])
@@ -45,7 +54,7 @@ def newton_sets(root: Path) -> dict:
     root = Path(root)
     accepted = sorted(root.glob("fem/inc-*/newton.csv"))
     failed = sorted(root.glob("failed-attempts/*-newton.csv"))
-    iters = lambda files: sum(max(sum(1 for _ in f.open()) - 2, 0) for f in files)
+    iters = lambda files: sum(max(len(f.read_text().splitlines()) - 2, 0) for f in files)
     with_c, without = [], []
     for f in accepted + failed:
         for changed, ratio in steps(f):
