@@ -106,7 +106,10 @@ def test_fe_cut_forms_a_chip(tmp_path, capsys):
     w = window([{k: float(v) for k, v in r.items()} for r in rows], h)
     assert float(said["last_h_Fc_N"]) == pytest.approx(w["steady_Fc_N"], rel=1e-5) and said["mu"] == "0.5"
     assert int(said["failed_tries"]) == ns["failed_tries"] and said["steady"] == "False"
-    assert bench_row([str(tmp_path), "steel"]) == 2 and bench_row([str(root), "brass"]) == 2
+    assert bench_row([str(tmp_path), "steel"]) == 2
+    assert capsys.readouterr().err == f"{tmp_path}: not the run folder of a cutting scene\n"
+    assert bench_row([str(root), "brass"]) == 2
+    assert capsys.readouterr().err == "usage: python -m wendel.bench.cutting RUN steel|titanium\n"
 
 
 def test_fe_cut_compiled_residual_pass_is_the_freefem_one(tmp_path):

@@ -212,9 +212,10 @@ def main(argv: list[str]) -> int:
     """``python -m wendel.bench.cutting RUN MATERIAL``: the bench's row of a cut's run folder (a bench's work folder
     or a ``wendel run`` of a cutting scene), as the scene was run, against the measured cuts of ``MATERIAL``
     (``steel``, ``titanium``); one ``key value`` a line."""
+    from ..cutting.experiments import MEASURED
     from ..cutting.fe_run import cutting_scene
-    if len(argv) != 2 or argv[1] not in ("steel", "titanium"):
-        print("usage: python -m wendel.bench.cutting RUN steel|titanium", file=sys.stderr)
+    if len(argv) != 2 or argv[1] not in MEASURED:
+        print(f"usage: python -m wendel.bench.cutting RUN {'|'.join(MEASURED)}", file=sys.stderr)
         return 2
     out = Path(argv[0])
     scene = cutting_scene(out)

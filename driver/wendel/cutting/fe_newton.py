@@ -34,8 +34,15 @@ def steps(path: Path) -> list[tuple[bool, float]]:
     >>> steps(p)          # step 1 left out (the increment's first), step 4 too (a trial that would invert a cell)
     [(True, 0.8), (False, 0.0025)]
     """
+    return _steps(_read(path))
+
+
+def _read(path: Path) -> list[dict]:
     with path.open() as f:
-        rows = list(csv.DictReader(f))
+        return list(csv.DictReader(f))
+
+
+def _steps(rows: list[dict]) -> list[tuple[bool, float]]:
     out = []
     for a, b in zip(rows[1:], rows[2:]):
         ra, rb = float(a["relative_residual"]), float(b["relative_residual"])
@@ -54,29 +61,28 @@ def newton_sets(root: Path) -> dict:
     root = Path(root)
     accepted = sorted(root.glob("fem/inc-*/newton.csv"))
     failed = sorted(root.glob("failed-attempts/*-newton.csv"))
-    iters = lambda files: sum(max(len(f.read_text().splitlines()) - 2, 0) for f in files)
+    iterations = {"accepted": 0, "failed": 0}
     with_c, without = [], []
-    for f in accepted + failed:
-        for changed, ratio in steps(f):
-            (with_c if changed else without).append(ratio)
+    for kind, files in (("accepted", accepted), ("failed", failed)):
+        for f in files:                 # each file read once: its iterations and its steps
+            rows = _read(f)
+            iterations[kind] += max(len(rows) - 1, 0)
+            for changed, ratio in _steps(rows):
+                (with_c if changed else without).append(ratio)
     n = len(with_c) + len(without)
     med = lambda xs: statistics.median(xs) if xs else math.nan
-    return {"increments": len(accepted), "iterations": iters(accepted), "failed_tries": len(failed),
-            "failed_iterations": iters(failed), "steps_counted": n,
+    return {"increments": len(accepted), "iterations": iterations["accepted"], "failed_tries": len(failed),
+            "failed_iterations": iterations["failed"], "steps_counted": n,
             "set_change_share": len(with_c) / n if n else math.nan,
             "contraction_with_set_changes": med(with_c), "contraction_without": med(without)}
 
 
 def main(argv: list[str]) -> int:
-    rows = [(p, newton_sets(Path(p))) for p in argv]
-    if not rows:
+    from ..bench import _table
+    if not argv:
         print("usage: python -m wendel.cutting.fe_newton RUN [RUN ...]", file=sys.stderr)
         return 2
-    keys = list(rows[0][1])
-    print("| run | " + " | ".join(keys) + " |")
-    print("|---|" + "---|" * len(keys))
-    for p, r in rows:
-        print(f"| {p} | " + " | ".join(f"{v:.3g}" if isinstance(v, float) else str(v) for v in r.values()) + " |")
+    print(_table([{"run": p, **newton_sets(Path(p))} for p in argv]))
     return 0
 
 
