@@ -14,7 +14,7 @@ SCENE ?= workflows/drilling-rz.toml   # the product's main job: a small drilling
 .PHONY: setup run test bench dealii clean
 setup: build/.apt-ok $(VENV)/.ok build/plugins/MUMPS_mpi.so build/plugins/wendel_petsc.so build/plugins/wendel_tool.so \
        build/plugins/wendel_kernels.so build/plugins/wendel_io.so build/plugins/wendel_mesh.so \
-       build/plugins/wendel_ul.so
+       build/plugins/wendel_ul.so build/plugins/wendel_plast.so
 	@# wendel's own bytecode, where PYTHONDONTWRITEBYTECODE=1 would compile it at every start (issue 20)
 	@$(VENV)/bin/python -m compileall -q driver/wendel meshes > /dev/null
 
@@ -53,6 +53,12 @@ build/plugins/wendel_kernels.so: edp/plugins/wendel_kernels.cpp build/.apt-ok
 build/plugins/wendel_ul.so: edp/plugins/wendel_ul.cpp build/.apt-ok
 	@mkdir -p build/plugins
 	g++ -shared -fPIC -O2 -Wall -Wno-unused-variable -Wno-sign-compare -Wno-mismatched-new-delete -isystem /usr/include/freefem++ $< -o $@
+
+# wendel's compiled Johnson-Cook return mapping (lib/plasticity.idp); no contraction into fused multiply-adds, so
+# that it does the array code's operations bit for bit.
+build/plugins/wendel_plast.so: edp/plugins/wendel_plast.cpp build/.apt-ok
+	@mkdir -p build/plugins
+	g++ -shared -fPIC -O2 -ffp-contract=off -Wall -Wno-unused-variable -Wno-sign-compare -Wno-mismatched-new-delete -isystem /usr/include/freefem++ $< -o $@
 
 # wendel's 3D mesh reader (lib/mesh.idp): gmshload3's mesh with the face adjacency built by sorting.
 build/plugins/wendel_mesh.so: edp/plugins/wendel_mesh.cpp build/.apt-ok
