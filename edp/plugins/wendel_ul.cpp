@@ -26,10 +26,17 @@
 //       components i d + j; c = [c1, c2, c3], 3 arrays): D_{pm,rk} = J [(c1 G_mp + Y_pm) G_kr + G_mr (c2 G_kp - Y_pk) / 2 - G_kp Y_rm / 2
 //       - c3 M_pm M_rk - S_pr H_mk / 2 + d_pr (c2 H_mk + Z_mk) / 2] at (ia na + ib) n + cell and P_pm = J Y_pm
 //       at ia n + cell, with Y = S G^T, M = N G^T, H = G G^T, Z = G Y. Returns n.
+//   long wendelUlExact2(real[int] S, real[int] N, real[int] c, real[int] X, real[int] G, real[int] J, int[int] act,
+//                       real[int] D);
+//       The plane (in-plane) part of the exact derivative of the strain update (ulExact of kinematics.idp, 2D and
+//       (r, z)) added to D (as wendelUlTangent's): c = [c2, c3] (2 arrays), X = [f11, f12, f21, f22, p, q, V11, V12,
+//       V22, beta] of the trial (10 arrays, ulTrial); S, N, G full d x d (d = 2, or 3 in (r, z)). The array code's
+//       operations in its order, per cell: the same D bit for bit (tests/test_plast_compiled.py). Returns n.
 #include "ff++.hpp"
 #include "AFunction_ext.hpp"
 
 #include <cmath>
+#include <vector>
 
 namespace {
 
@@ -249,6 +256,175 @@ long wendelUlTangent(KN<double>* const& pS, KN<double>* const& pN, KN<double>* c
     return n;
 }
 
+
+// out = 1 where x > 0, else 0 (ulStep of kinematics.idp)
+inline double ulStep(double x)
+{
+    double a = std::fabs(x);
+    double o = x + a;
+    a *= 2.;
+    a += 1e-300;
+    return o / a;
+}
+
+long wendelUlExact2(KN<double>* const& pS, KN<double>* const& pN, KN<double>* const& pc, KN<double>* const& pX,
+                    KN<double>* const& pG, KN<double>* const& pJ, KN<long>* const& pact, KN<double>* const& pD)
+{
+    const KN<double>& S = *pS;
+    const KN<double>& N = *pN;
+    const KN<double>& G = *pG;
+    const KN<double>& X = *pX;
+    const long n = pJ->N(), na = pact->N();
+    if (n == 0) return 0;
+    const long d = S.N() == 4 * n ? 2 : 3;
+    if (S.N() != d * d * n || N.N() != S.N() || G.N() != S.N() || pc->N() != 2 * n || X.N() != 10 * n
+        || pD->N() != na * na * n)
+        ExecError("wendelUlExact2: array sizes");
+    KN<double>& D = *pD;
+    const KN<double>& J = *pJ;
+    const int comp[4] = {0, 1, 1, 2};
+    std::vector<int> p_(na), m_(na);
+    for (long a = 0; a < na; ++a) {
+        const long c = (*pact)[a];
+        p_[a] = (int)(c / d);
+        m_[a] = (int)(c % d);
+    }
+    for (long k = 0; k < n; ++k) {
+        const double f11 = X[k], f12 = X[n + k], f21 = X[2 * n + k], f22 = X[3 * n + k], p = X[4 * n + k],
+                     q = X[5 * n + k], V11 = X[6 * n + k], V12 = X[7 * n + k], V22 = X[8 * n + k], be = X[9 * n + k];
+        const double c2 = (*pc)[k], c3 = (*pc)[n + k];
+        double w = q * q;
+        double r2 = p * p;
+        r2 += w;
+        double vdd = V11 - V22, vm = V11 + V22;
+        vdd *= 0.5;
+        vm *= 0.5;
+        double h2 = vdd * vdd;
+        w = V12 * V12;
+        h2 += w;
+        double vdet = vm * vm;
+        vdet -= h2;
+        w = vm * vm;
+        const double tq = h2 / w;
+        double vga = vm / vdet;
+        vga -= be;
+        w = h2;
+        w += 1e-300;
+        vga = vga / w;
+        double gs = tq;
+        gs *= 6. / 7.;
+        gs += 4. / 5.;
+        gs = gs * tq;
+        gs += 2. / 3.;
+        w = vm * vm;
+        w = w * vm;
+        gs = gs / w;
+        w = tq;
+        w -= 1e-4;
+        const double bg = ulStep(w);
+        vga -= gs;
+        vga = vga * bg;
+        vga += gs;
+        double K00 = S[(0 * d + 1) * n + k];
+        K00 *= -2.;
+        const double K11 = -K00;
+        double K01 = S[k];
+        w = S[(d + 1) * n + k];
+        K01 -= w;
+        const double N00 = N[k], N01 = N[n + k], N11 = N[(d + 1) * n + k], N22 = d == 3 ? N[8 * n + k] : 0.;
+        double dT[4][4];                      // basis (r v) = 2 r + v; components 00, 01, 11, 22
+        for (int r = 0; r < 2; ++r)
+            for (int v = 0; v < 2; ++v) {
+                const double fv0 = v == 0 ? f11 : f21, fv1 = v == 0 ? f12 : f22;
+                const double Vv0 = v == 0 ? V11 : V12, Vv1 = v == 0 ? V12 : V22;
+                const double dp = r == 0 ? fv0 : fv1, dq = r == 0 ? -fv1 : fv0;
+                double dth = p * dq;
+                w = q * dp;
+                dth -= w;
+                dth = dth / r2;
+                double dV00 = V12 * dth, dV01 = V11 - V22;
+                dV00 = -dV00;
+                double dV11 = -dV00;
+                dV01 = dV01 * dth;
+                if (r == 0) {
+                    dV00 += Vv0;
+                    dV01 += Vv1;
+                }
+                else {
+                    dV11 += Vv1;
+                    dV01 += Vv0;
+                }
+                dV01 *= 0.5;
+                double dm = dV00 + dV11, ddd = dV00 - dV11;
+                dm *= 0.5;
+                ddd *= 0.5;
+                double da = V22 * dV00;
+                w = V11 * dV11;
+                da += w;
+                w = V12 * dV01;
+                da -= 2. * w;
+                da = da / vdet;
+                da *= 0.5;
+                double db = vdd * ddd;
+                w = V12 * dV01;
+                db += w;
+                db = db * vga;
+                w = dm / vdet;
+                db -= w;
+                const double bth = be * dth;
+                double e00 = db * vdd, e01 = db * V12;
+                w = be * ddd;
+                e00 += w;
+                double e11 = -e00;
+                e00 += da;
+                e11 += da;
+                w = V12 * bth;
+                e00 += 2. * w;
+                e11 -= 2. * w;
+                w = be * dV01;
+                e01 += w;
+                w = vdd * bth;
+                e01 -= 2. * w;
+                if (r == 0 && v == 0) e00 -= 1.;
+                if (r == 1 && v == 1) e11 -= 1.;
+                if (r != v) e01 -= 0.5;
+                if (r == 1 && v == 0) dth -= 0.5;
+                if (r == 0 && v == 1) dth += 0.5;
+                double ne = N00 * e00;
+                w = N11 * e11;
+                ne += w;
+                w = N01 * e01;
+                ne += 2. * w;
+                ne = ne * c3;
+                double* t = dT[2 * r + v];
+                double w2;
+                w = c2 * e00; w2 = N00 * ne; w -= w2; w2 = K00 * dth; w += w2; t[0] = w;
+                w = c2 * e01; w2 = N01 * ne; w -= w2; w2 = K01 * dth; w += w2; t[1] = w;
+                w = c2 * e11; w2 = N11 * ne; w -= w2; w2 = K11 * dth; w += w2; t[2] = w;
+                w = N22 * ne; w = -w; t[3] = w;
+            }
+        for (long ia = 0; ia < na; ++ia)
+            for (long ib = 0; ib < na; ++ib) {
+                const int pp = p_[ia], m = m_[ia], r = p_[ib], kk = m_[ib];
+                if (r == 2) continue;             // the hoop column: exact already
+                w = 0.;
+                for (int qq = 0; qq < d; ++qq) {
+                    if ((pp == 2) != (qq == 2)) continue;
+                    const int c = pp == 2 ? 3 : comp[2 * pp + qq];
+                    for (int v = 0; v < 2; ++v) {
+                        double w2 = dT[2 * r + v][c];
+                        w2 = w2 * G[(m * d + qq) * n + k];
+                        w2 = w2 * G[(kk * d + v) * n + k];
+                        w += w2;
+                    }
+                }
+                w = w * J[k];
+                D[(ia * na + ib) * n + k] += w;
+            }
+    }
+    return n;
+}
+
 }  // namespace
 
 static void Load_Init()
@@ -259,5 +435,8 @@ static void Load_Init()
     Global.Add("wendelUlTangent", "(",
                new OneOperator8_<long, KN<double>*, KN<double>*, KN<double>*, KN<double>*, KN<double>*, KN<long>*,
                                  KN<double>*, KN<double>*>(wendelUlTangent));
+    Global.Add("wendelUlExact2", "(",
+               new OneOperator8_<long, KN<double>*, KN<double>*, KN<double>*, KN<double>*, KN<double>*, KN<double>*,
+                                 KN<long>*, KN<double>*>(wendelUlExact2));
 }
 LOADFUNC(Load_Init)

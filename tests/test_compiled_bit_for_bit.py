@@ -1,9 +1,12 @@
-"""Johnson-Cook's return mapping compiled (edp/plugins/wendel_plast.cpp, plastReturn of edp/lib/plasticity.idp)
-against the array code it replaces (`-plast_compiled 0` on every launch): the same runs bit for bit, every
-cell, node and state file of every increment and every record entry but the timers. On the FE cut (2D,
+"""Per-point work compiled against the array code it replaces, on every launch (`-plast_compiled 0
+-ul_exact_compiled 0`): Johnson-Cook's return mapping (edp/plugins/wendel_plast.cpp, plastReturn of
+edp/lib/plasticity.idp) and the exact derivative of the plane updated-Lagrangian strain update
+(wendelUlExact2 of edp/plugins/wendel_ul.cpp, ulExact of edp/lib/kinematics.idp). The same runs bit for bit:
+every cell, node and state file of every increment and every record entry but the timers. On the FE cut (2D,
 updated-Lagrangian with F-bar, heat by conduction, rate-dependent, remeshed: a re-equilibration without time
 runs on the kept rate factors), the 3D JC cube with and without the compiled element kernels (their points'
-subsets), and the 2D heated indentation (monolithic heat, rate-dependent)."""
+subsets), the 2D heated indentation (monolithic heat, rate-dependent), the (r, z) necking bar (F-bar, Voce)
+and the plane plastic shear to large strain."""
 
 from __future__ import annotations
 
@@ -15,6 +18,8 @@ import pytest
 
 from conftest import WORKFLOWS
 from wendel import freefem
+
+ARRAY_CODE = ["-plast_compiled", "0", "-ul_exact_compiled", "0"]
 
 
 def _same_increments(a: Path, b: Path) -> int:
@@ -36,13 +41,13 @@ def _same_increments(a: Path, b: Path) -> int:
 
 
 def _array_code(monkeypatch):
-    """Every later launch with the array code (-plast_compiled 0)."""
+    """Every later launch with the array code."""
     command = freefem._command
     monkeypatch.setattr(freefem, "_command", lambda entry, options, *a, **k:
-                        command(entry, [*options, "-plast_compiled", "0"], *a, **k))
+                        command(entry, [*options, *ARRAY_CODE], *a, **k))
 
 
-def test_cut_with_the_compiled_return_mapping_is_the_array_codes_bit_for_bit(tmp_path, monkeypatch):
+def test_cut_compiled_is_the_array_codes_bit_for_bit(tmp_path, monkeypatch):
     from wendel.cutting.fe_run import run_cut
     from wendel.scene import load
     path = WORKFLOWS / "cutting-aisi1045.toml"
@@ -70,9 +75,9 @@ def test_cut_with_the_compiled_return_mapping_is_the_array_codes_bit_for_bit(tmp
 
 
 @pytest.mark.parametrize("scene, assembly", [("uniaxial-jc", "freefem"), ("uniaxial-jc", "compiled"),
-                                             ("thermo-indent", "freefem")])
-def test_jc_scene_with_the_compiled_return_mapping_is_the_array_codes_bit_for_bit(tmp_path, monkeypatch, scene,
-                                                                                    assembly):
+                                             ("thermo-indent", "freefem"), ("ul-necking-bar", "freefem"),
+                                             ("ul-shear-plastic", "freefem")])
+def test_scene_compiled_is_the_array_codes_bit_for_bit(tmp_path, monkeypatch, scene, assembly):
     from wendel.loop import run
     text = (WORKFLOWS / f"{scene}.toml").read_text()
     if assembly == "compiled":
@@ -83,6 +88,8 @@ def test_jc_scene_with_the_compiled_return_mapping_is_the_array_codes_bit_for_bi
     compiled = run(path, smoke=True, out=tmp_path / "compiled", png=False, progress=lambda *_: None)
     _array_code(monkeypatch)
     array = run(path, smoke=True, out=tmp_path / "array", png=False, progress=lambda *_: None)
-    assert "-plast_compiled 0" in (array / "freefem.log").read_text()
-    assert "-plast_law 2" in (array / "freefem.log").read_text()
+    log = (array / "freefem.log").read_text()
+    assert "-plast_compiled 0" in log and "-plast_compiled" not in (compiled / "freefem.log").read_text()
+    assert ("-plast_law 2" in log) == (scene in ("uniaxial-jc", "thermo-indent"))
+    assert ("-DUPDATEDLAGRANGIAN=1" in log) == scene.startswith("ul-")
     assert _same_increments(compiled / "fem", array / "fem") >= 2
