@@ -72,6 +72,13 @@ def test_cut_compiled_is_the_array_codes_bit_for_bit(tmp_path, monkeypatch):
            [{k: v for k, v in r.items() if not k.startswith("time")} for r in rows[1]]
     reeq = [r for r in rows[0] if r["reequilibration"] == "1"]
     assert reeq                                    # a re-equilibration without time (the kept rate factors)
+    # where the last launch's seconds go (python -m wendel.bench.profile): every hook of a cut timed, within the launch
+    from wendel.bench.profile import last_launch, profile_once, table
+    prof = profile_once(last_launch(compiled), [])
+    hooks = ("module_trial", "thermal_residual", "tangent_matrix", "module_constrain", "solve")
+    assert all(prof[h][1] > 0 for h in hooks)
+    assert 0 < sum(v for h, (v, _) in prof.items() if h != "launch_wall") < prof["launch_wall"][0]
+    assert "| solve |" in table([prof], [prof])
 
 
 @pytest.mark.parametrize("scene, assembly", [("uniaxial-jc", "freefem"), ("uniaxial-jc", "compiled"),
