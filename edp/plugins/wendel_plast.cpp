@@ -19,6 +19,7 @@
 #include "ff++.hpp"
 #include "AFunction_ext.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -153,9 +154,14 @@ long wendelJcReturn(KN<double>* const& par, KN<double>* const& pin, KN<double>* 
     }
     long its = -1;
     for (long it = 0; it < j.maxit; ++it) {
+        // the largest |g| as KN::linfty takes it over all points in order (s = std::max(|g_k|, s); the points that
+        // do not yield have g = 0, which matters only after a NaN: std::max(0, NaN) is 0)
         double gmax = 0.;
+        long prev = -1;
         for (long a = 0; a < na; ++a) {
             const long k = act[a];
+            if (k > prev + 1) gmax = std::max(0., gmax);
+            prev = k;
             double syl, d;
             yield(j, in[k] + dp[k], dp[k], in[n + k], j.frozen ? in[2 * n + k] : 1., syl, d);
             dsy[k] = d;
@@ -163,9 +169,9 @@ long wendelJcReturn(KN<double>* const& par, KN<double>* const& pin, KN<double>* 
             gg -= mu3 * dp[k];
             gg = gg * plastic[k];
             g[a] = gg;
-            const double ag = std::fabs(gg);
-            gmax = gmax < ag ? ag : gmax;
+            gmax = std::max(std::fabs(gg), gmax);
         }
+        if (n > prev + 1) gmax = std::max(0., gmax);
         if (gmax <= gTol) {
             its = it;
             break;
