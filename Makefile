@@ -50,13 +50,13 @@ build/plugins/wendel_kernels.so: edp/plugins/wendel_kernels.cpp build/.apt-ok
 	g++ -shared -fPIC -O2 -Wall -Wno-unused-variable -Wno-sign-compare -Wno-mismatched-new-delete -isystem /usr/include/freefem++ $< -o $@
 
 # wendel's compiled per-cell kernels of the updated-Lagrangian kinematics (lib/kinematics.idp, kinematics-3d.idp).
-build/plugins/wendel_ul.so: edp/plugins/wendel_ul.cpp build/.apt-ok
+build/plugins/wendel_ul.so: edp/plugins/wendel_ul.cpp edp/plugins/wendel_step.hpp build/.apt-ok
 	@mkdir -p build/plugins
 	g++ -shared -fPIC -O2 -ffp-contract=off -Wall -Wno-unused-variable -Wno-sign-compare -Wno-mismatched-new-delete -isystem /usr/include/freefem++ $< -o $@
 
 # wendel's compiled Johnson-Cook return mapping (lib/plasticity.idp); no contraction into fused multiply-adds, so
 # that it does the array code's operations bit for bit.
-build/plugins/wendel_plast.so: edp/plugins/wendel_plast.cpp build/.apt-ok
+build/plugins/wendel_plast.so: edp/plugins/wendel_plast.cpp edp/plugins/wendel_step.hpp build/.apt-ok
 	@mkdir -p build/plugins
 	g++ -shared -fPIC -O2 -ffp-contract=off -Wall -Wno-unused-variable -Wno-sign-compare -Wno-mismatched-new-delete -isystem /usr/include/freefem++ $< -o $@
 

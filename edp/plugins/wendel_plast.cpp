@@ -18,6 +18,7 @@
 //       not reach the tolerance.
 #include "ff++.hpp"
 #include "AFunction_ext.hpp"
+#include "wendel_step.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -30,22 +31,6 @@ struct Jc {
     long maxit;
     bool frozen;
 };
-
-// plastStep: 1 where x > 0, else 0, as (x + |x|) / (2 |x| + 1e-300); plastPos: max(x, 0) as (x + |x|) / 2
-inline double step(double x)
-{
-    double a = std::fabs(x);
-    double o = x + a;
-    a *= 2.;
-    a += 1e-300;
-    return o / a;
-}
-inline double pos(double x)
-{
-    double a = std::fabs(x);
-    double o = x + a;
-    return o * 0.5;
-}
 
 // plastYield of law 2 (not adiabatic) at one point: sy and d sy / d dp at p = pp, increment dp
 inline void yield(const Jc& j, double pp, double dp, double tfac, double rfKept, double& sy, double& dsy)
@@ -67,8 +52,8 @@ inline void yield(const Jc& j, double pp, double dp, double tfac, double rfKept,
         w = dp;
         w *= 1. / (j.dt * j.rate0);
         w -= 1.;
-        double m = step(w);
-        rf = pos(w);
+        double m = wendelStep(w);
+        rf = wendelPos(w);
         rf += 1.;
         rf = std::log(rf);
         rf *= j.C;
@@ -139,9 +124,9 @@ long wendelJcReturn(KN<double>* const& par, KN<double>* const& pin, KN<double>* 
         yield(j, in[k], 0., in[n + k], j.frozen ? in[2 * n + k] : 1., sy, d);
         const double ftr = qtr[k] - sy;
         ftrs[k] = ftr;
-        plastic[k] = step(ftr - yieldTol);
+        plastic[k] = wendelStep(ftr - yieldTol);
         if (plastic[k] != 0.) act.push_back(k);
-        dp[k] = pos(ftr) * plastic[k];
+        dp[k] = wendelPos(ftr) * plastic[k];
         dp[k] *= onMu3;
     }
     // the scalar Newton of every yielding point, bracketed, stopped together (plastReturn's loop)
@@ -179,7 +164,7 @@ long wendelJcReturn(KN<double>* const& par, KN<double>* const& pin, KN<double>* 
         for (long a = 0; a < na; ++a) {
             const long k = act[a];
             const double gg = g[a], x = dp[k];
-            double mpos = step(gg);
+            double mpos = wendelStep(gg);
             double w = x - lo[a];
             w = w * mpos;
             lo[a] += w;
@@ -196,8 +181,8 @@ long wendelJcReturn(KN<double>* const& par, KN<double>* const& pin, KN<double>* 
             w += mu3;
             double newt = gg / w;
             newt += x;
-            double inside = step(newt - lo[a]);
-            mpos = step(hi[a] - newt);
+            double inside = wendelStep(newt - lo[a]);
+            mpos = wendelStep(hi[a] - newt);
             inside = inside * mpos;
             double mid = glo[a] - ghi[a];
             mid += 1e-300;
@@ -228,7 +213,7 @@ long wendelJcReturn(KN<double>* const& par, KN<double>* const& pin, KN<double>* 
         gm *= mu2;
         w = keep * th;
         w -= gm;
-        const double w2 = pos(w);
+        const double w2 = wendelPos(w);
         gm = keep * th;
         gm -= w2;
         const double snr = sn[k] + 1e-300;

@@ -34,6 +34,7 @@
 //       operations in its order, per cell: the same D bit for bit (tests/test_plast_compiled.py). Returns n.
 #include "ff++.hpp"
 #include "AFunction_ext.hpp"
+#include "wendel_step.hpp"
 
 #include <cmath>
 #include <vector>
@@ -257,16 +258,6 @@ long wendelUlTangent(KN<double>* const& pS, KN<double>* const& pN, KN<double>* c
 }
 
 
-// out = 1 where x > 0, else 0 (ulStep of kinematics.idp)
-inline double ulStep(double x)
-{
-    double a = std::fabs(x);
-    double o = x + a;
-    a *= 2.;
-    a += 1e-300;
-    return o / a;
-}
-
 long wendelUlExact2(KN<double>* const& pS, KN<double>* const& pN, KN<double>* const& pc, KN<double>* const& pX,
                     KN<double>* const& pG, KN<double>* const& pJ, KN<long>* const& pact, KN<double>* const& pD)
 {
@@ -321,7 +312,7 @@ long wendelUlExact2(KN<double>* const& pS, KN<double>* const& pN, KN<double>* co
         gs = gs / w;
         w = tq;
         w -= 1e-4;
-        const double bg = ulStep(w);
+        const double bg = wendelStep(w);
         vga -= gs;
         vga = vga * bg;
         vga += gs;
