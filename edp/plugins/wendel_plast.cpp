@@ -5,7 +5,7 @@
 // and powers per point and round, in an increment of the FE cut: 9 ms a residual at 3,600 cells, most of it the
 // interpreter's cost per operation). This loop does the same floating-point operations in the same order per
 // point, skips the points that do not yield (their increment stays 0 in the array code too) and keeps the joint
-// stopping test, so that its results are the array code's bit for bit (tests/test_plast_compiled.py).
+// stopping test, so that its results are the array code's bit for bit (tests/test_compiled_bit_for_bit.py).
 //
 // Registered in the FreeFEM language (load "wendel_plast"):
 //
@@ -101,6 +101,7 @@ long wendelJcReturn(KN<double>* const& par, KN<double>* const& pin, KN<double>* 
     const double onMu3 = 1. / mu3, yieldTol = 1e-12 * j.sref, gTol = j.tol * j.sref, keep = 1. - j.reg;
     std::vector<double> tr(n), sn(n), qtr(n), ftrs(n), plastic(n), dp(n, 0.), dsy(n, 0.), str(nS * n);
     std::vector<long> act;                  // the yielding points
+    auto kept = [&](long k) { return j.frozen ? in[2 * n + k] : 1.; };     // the rate factor plastYield keeps
     for (long k = 0; k < n; ++k) {
         double t = 0.;
         for (int c = 0; c < 3; ++c) {
@@ -121,7 +122,7 @@ long wendelJcReturn(KN<double>* const& par, KN<double>* const& pin, KN<double>* 
         sn[k] = s;
         qtr[k] = s15 * s;
         double sy, d;
-        yield(j, in[k], 0., in[n + k], j.frozen ? in[2 * n + k] : 1., sy, d);
+        yield(j, in[k], 0., in[n + k], kept(k), sy, d);
         const double ftr = qtr[k] - sy;
         ftrs[k] = ftr;
         plastic[k] = wendelStep(ftr - yieldTol);
@@ -148,7 +149,7 @@ long wendelJcReturn(KN<double>* const& par, KN<double>* const& pin, KN<double>* 
             if (k > prev + 1) gmax = std::max(0., gmax);
             prev = k;
             double syl, d;
-            yield(j, in[k] + dp[k], dp[k], in[n + k], j.frozen ? in[2 * n + k] : 1., syl, d);
+            yield(j, in[k] + dp[k], dp[k], in[n + k], kept(k), syl, d);
             dsy[k] = d;
             double gg = qtr[k] - syl;
             gg -= mu3 * dp[k];
@@ -232,7 +233,7 @@ long wendelJcReturn(KN<double>* const& par, KN<double>* const& pin, KN<double>* 
         }
         const double p = in[k] + dp[k];
         double sy, d;
-        yield(j, p, dp[k], in[n + k], j.frozen ? in[2 * n + k] : 1., sy, d);
+        yield(j, p, dp[k], in[n + k], kept(k), sy, d);
         out[k] = p;
         out[n + k] = sy;
         out[2 * n + k] = th;

@@ -74,22 +74,18 @@ def table(runs: list[dict[str, tuple[float, int]]], base: list[dict[str, tuple[f
     wall = statistics.median(r["launch_wall"][0] for r in runs)
     rows = []
     hooks = [h for h in runs[0] if h != "launch_wall"]
+    # the median seconds of a hook over replays; "other": the launch outside every hook
+    seconds = lambda rs, h: statistics.median(r["launch_wall"][0] - sum(r[k][0] for k in hooks) if h == "other"
+                                              else r[h][0] for r in rs)
     for h in [*hooks, "other", "launch_wall"]:
-        if h == "other":
-            sec = [r["launch_wall"][0] - sum(r[k][0] for k in hooks) for r in runs]
-            calls = 1
-        else:
-            sec, calls = [r[h][0] for r in runs], runs[0][h][1]
-        s = statistics.median(sec)
+        calls = 1 if h == "other" else runs[0][h][1]
+        s = seconds(runs, h)
         if h not in ("other", "launch_wall") and s < 1e-3 * wall:
             continue
         row = {"hook": h, "calls": calls, "seconds": f"{s:.3f}", "ms a call": f"{1e3 * s / max(calls, 1):.2f}",
                "share": f"{100 * s / wall:.1f} %"}
         if base:
-            if h == "other":
-                b = statistics.median(r["launch_wall"][0] - sum(r[k][0] for k in hooks) for r in base)
-            else:
-                b = statistics.median(r[h][0] for r in base)
+            b = seconds(base, h)
             row["base seconds"] = f"{b:.3f}"
             row["ratio"] = f"{s / b:.2f}" if b > 0 else "-"
         rows.append(row)
