@@ -1,5 +1,6 @@
 """Where an FE cut's Newton iterations go: steps after which the contact or friction sets changed, and those after
-which they did not (``python -m wendel.cutting.fe_newton RUN [RUN ...]``; a row of ``wendel bench cutting``).
+which they did not (``python -m wendel.cutting.fe_newton RUN [RUN ...]``; a row of ``wendel bench cutting``), and
+the Newton iterations of its increments by load step (``--steps``).
 
 Each Newton step of an increment (``fem/inc-*/newton.csv``; the failed tries' ``failed-attempts/*-newton.csv``)
 solved on the sets of the iterate before it. The iterate it gives says whether those sets still hold
@@ -77,11 +78,48 @@ def newton_sets(root: Path) -> dict:
             "contraction_with_set_changes": med(with_c), "contraction_without": med(without)}
 
 
+def newton_by_step(root: Path) -> list[dict]:
+    """The accepted increments of a run (history.csv) by their load step, as a fraction of the largest (a step
+    cut halves it), and the re-equilibrations (steps without time after a remesh) apart: how many, their mean
+    Newton iterations and those per largest step.
+
+    >>> import tempfile; d = Path(tempfile.mkdtemp())
+    >>> rows = ["increment,load_factor,newton_iterations,reequilibration", "1,0.25,8,0", "2,0.375,6,0",
+    ...         "3,0.5,4,0", "4,0.5,30,1", "5,0.75,10,0"]
+    >>> _ = (d / "history.csv").write_text("\\n".join(rows) + "\\n")
+    >>> [(r["step"], r["increments"], r["mean_iterations"], r["iterations_per_full_step"]) for r in newton_by_step(d)]
+    [('1', 2, 9.0, 9.0), ('1/2', 2, 5.0, 10.0), ('re-equilibration', 1, 30.0, '')]
+    """
+    with open(Path(root) / "history.csv") as f:
+        rows = list(csv.DictReader(f))
+    last, steps = 0.0, []
+    for r in rows:
+        lf = float(r["load_factor"])
+        steps.append((lf - last, int(r["newton_iterations"]), r.get("reequilibration") == "1"))
+        last = lf
+    full = max(d for d, _, re in steps if not re)
+    groups: dict[int, list[int]] = {}
+    for d, its, re in steps:
+        key = -1 if re else round(math.log2(full / d))      # a step of full / 2^k
+        groups.setdefault(key, []).append(its)
+    out = []
+    for k in sorted(groups, key=lambda k: (k < 0, k)):
+        its = groups[k]
+        mean = sum(its) / len(its)
+        out.append({"step": "re-equilibration" if k < 0 else ("1" if k == 0 else f"1/{2 ** k}"),
+                    "increments": len(its), "mean_iterations": round(mean, 1),
+                    "iterations_per_full_step": "" if k < 0 else round(mean * 2 ** k, 1)})
+    return out
+
+
 def main(argv: list[str]) -> int:
     from ..bench import _table
-    if not argv:
-        print("usage: python -m wendel.cutting.fe_newton RUN [RUN ...]", file=sys.stderr)
+    if not argv or argv == ["--steps"]:
+        print("usage: python -m wendel.cutting.fe_newton [--steps] RUN [RUN ...]", file=sys.stderr)
         return 2
+    if argv[0] == "--steps":
+        print(_table([{"run": p, **r} for p in argv[1:] for r in newton_by_step(Path(p))]))
+        return 0
     print(_table([{"run": p, **newton_sets(Path(p))} for p in argv]))
     return 0
 
