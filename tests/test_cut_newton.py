@@ -71,3 +71,21 @@ def test_newton_rows_count_the_points_in_flow_and_their_switches(cut):
     assert len(points) > 10 and max(s for _, _, s in points) > 0     # consecutive rows of one increment
     for a, b, s in points:
         assert abs(a - b) <= s <= a + b, (a, b, s)
+
+
+def test_a_step_from_an_accepted_state_is_the_step_the_run_made(cut):
+    # python -m wendel.bench.newton_replay --states: a whole step from an accepted state with the first guess the
+    # loop gives it converges in the run's own Newton iterations; without that guess it takes others (the launch
+    # as it ran, the state and its tables: what the states experiment of session 31 stands on)
+    import json
+    hist = {int(r["increment"]): r for r in csv.DictReader((cut / "history.csv").open())}
+    words = last_launch(cut)
+    picked = [st for st in newton_replay.states(cut, 1, start=0.0) if st[0] + 1 in hist]
+    assert picked, json.loads((cut / "checkpoint.json").read_text())["accepted"]
+    n = picked[0][0]
+    with newton_replay.tempfile.TemporaryDirectory() as tmp:
+        full = newton_replay.step_from(cut, words, picked[0], "full", Path(tmp) / "full")
+        bare = newton_replay.step_from(cut, words, picked[0], "nopred", Path(tmp) / "nopred")
+    assert full["exit"] == 0 and full["increments"] == 1
+    assert full["iterations"] == int(hist[n + 1]["newton_iterations"])
+    assert bare["iterations"] + bare["failed_iterations"] != full["iterations"]
