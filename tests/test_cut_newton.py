@@ -5,7 +5,9 @@ rows), and the replay of a cut's last launch with other Newton options (`python 
 from __future__ import annotations
 
 import csv
+import json
 import statistics
+import tempfile
 from pathlib import Path
 
 import pytest
@@ -35,11 +37,9 @@ def test_the_cut_tangent_is_its_residual_derivative_away_from_the_contact_nodes(
     # the residual's kinks). Measured (session 31): 2.7e-9 median, 2.3e-5 at most over 33 directions; with the contact
     # nodes moved and their rows compared, 3.1 % median (the check before session 31); on the end of the steady
     # steel cut, 5.3e-5 median (fdcheck.idp)
-    words = last_launch(cut)
-    with newton_replay.tempfile.TemporaryDirectory() as tmp:
-        out = Path(tmp)
-        newton_replay.subprocess.run(newton_replay.replay_command(words, out, ["-newton_fd_check", "1e-6"]),
-                                     env=newton_replay.freefem.environment(), capture_output=True, check=True)
+    with tempfile.TemporaryDirectory() as tmp:
+        out = Path(tmp) / "fd"
+        assert newton_replay.replay(last_launch(cut), ["-newton_fd_check", "1e-6"], keep=out)["exit"] == 0
         rows = list(csv.DictReader((out / "fdcheck.csv").open()))
     random = [float(r["relative_difference"]) for r in rows if r["direction"] == "random" and r["iteration"] != "0"]
     assert len(random) >= 5
@@ -77,13 +77,12 @@ def test_a_step_from_an_accepted_state_is_the_step_the_run_made(cut):
     # python -m wendel.bench.newton_replay --states: a whole step from an accepted state with the first guess the
     # loop gives it converges in the run's own Newton iterations; without that guess it takes others (the launch
     # as it ran, the state and its tables: what the states experiment of session 31 stands on)
-    import json
     hist = {int(r["increment"]): r for r in csv.DictReader((cut / "history.csv").open())}
     words = last_launch(cut)
     picked = [st for st in newton_replay.states(cut, 1, start=0.0) if st[0] + 1 in hist]
     assert picked, json.loads((cut / "checkpoint.json").read_text())["accepted"]
     n = picked[0][0]
-    with newton_replay.tempfile.TemporaryDirectory() as tmp:
+    with tempfile.TemporaryDirectory() as tmp:
         full = newton_replay.step_from(cut, words, picked[0], "full", Path(tmp) / "full")
         bare = newton_replay.step_from(cut, words, picked[0], "nopred", Path(tmp) / "nopred")
     assert full["exit"] == 0 and full["increments"] == 1

@@ -50,16 +50,20 @@ def counts(out: Path) -> dict[str, int]:
             "failed_iterations": int(json.loads(failed.read_text())["iterations"]) if failed.is_file() else 0}
 
 
+def _launch(cmd: list[str], out: Path) -> dict:
+    """Run a FreeFEM launch into ``out``: its exit code, :func:`counts` and wall time."""
+    t0 = time.perf_counter()
+    done = subprocess.run(cmd, env=freefem.environment(), capture_output=True, text=True)
+    return {"exit": done.returncode, **counts(out), "wall_s": round(time.perf_counter() - t0, 2)}
+
+
 def replay(words: list[str], extra: list[str], keep: Path | None = None) -> dict:
     """One replay of a launch with ``extra`` options: exit code, counts and wall time (its folder kept as ``keep``,
     which must not exist, when given: the launch's files, fdcheck.csv with ``-newton_fd_check``)."""
     with tempfile.TemporaryDirectory(prefix="wendel-newton-replay-") as tmp:
         out = keep or Path(tmp) / "fem"
         out.mkdir(parents=True)
-        t0 = time.perf_counter()
-        done = subprocess.run(replay_command(words, out, extra), env=freefem.environment(), capture_output=True,
-                              text=True)
-        return {"exit": done.returncode, **counts(out), "wall_s": f"{time.perf_counter() - t0:.1f}"}
+        return _launch(replay_command(words, out, extra), out)
 
 
 VARIANTS = {"full": (1,), "nopred": (1,), "half": (0.5, 1), "quarter": (0.25, 0.5, 0.75, 1), "double": (2,)}
@@ -84,10 +88,10 @@ def _set(words: list[str], name: str, value: str | None) -> list[str]:
     return words
 
 
-def states(run: Path, count: int, start: float = 0.1) -> list[tuple[int, float, float, dict]]:
+def states(run: Path, count: int, start: float = 0.1) -> list[tuple[int, float, float, dict, float]]:
     """``count`` accepted increments of a run to start steps from: (increment, load factor, its step, its mesh
-    segment), inside a segment after its re-equilibration, at a whole step's load factor, from load factor
-    ``start`` (a tenth of the travel) on."""
+    segment, the whole step), inside a segment after its re-equilibration, at a whole step's load factor, from
+    load factor ``start`` (a tenth of the travel) on."""
     ck = json.loads((run / "checkpoint.json").read_text())
     step = 1.0 / ck["scene"]["loading"]["steps"]
     lf_of = dict(map(tuple, ck["accepted"]))
@@ -96,7 +100,7 @@ def states(run: Path, count: int, start: float = 0.1) -> list[tuple[int, float, 
         seg = [s for s in ck["segments"] if s["first"] <= n][-1]
         dlf = lf - lf_of.get(n - 1, lf)
         if n - 1 > seg["first"] and dlf > 0 and abs(lf / step - round(lf / step)) < 1e-6 and lf >= start:
-            found.append((n, lf, dlf, seg))
+            found.append((n, lf, dlf, seg, step))
     if len(found) < count:
         raise SystemExit(f"{run}: {len(found)} states to start from, not {count}")
     return [found[round(k * (len(found) - 1) / max(count - 1, 1))] for k in range(count)]
@@ -105,8 +109,7 @@ def states(run: Path, count: int, start: float = 0.1) -> list[tuple[int, float, 
 def step_from(run: Path, words: list[str], state: tuple, variant: str, out: Path) -> dict:
     """One variant's steps from one state (the run's last launch with its segment's mesh, the state as restart,
     the loads and the first guess of the variant)."""
-    n, lf, dlf, seg = state
-    step = 1.0 / json.loads((run / "checkpoint.json").read_text())["scene"]["loading"]["steps"]
+    n, lf, dlf, seg, step = state
     out.mkdir(parents=True)
     loads = [lf + f * step for f in VARIANTS[variant]]
     (out / "loads.txt").write_text(f"{len(loads)}\n" + "".join(f"{x!r}\n" for x in loads))
@@ -124,10 +127,7 @@ def step_from(run: Path, words: list[str], state: tuple, variant: str, out: Path
                  "-predictor_lf": repr(lf)}
     for name, value in guess.items():
         w = _set(w, name, value)
-    t0 = time.perf_counter()
-    done = subprocess.run(w, env=freefem.environment(), capture_output=True, text=True)
-    return {"state": n, "variant": variant, "exit": done.returncode, **counts(out),
-            "wall_s": round(time.perf_counter() - t0, 2)}
+    return {"state": n, "variant": variant, **_launch(w, out)}
 
 
 def policies(rows: list[dict]) -> dict:
@@ -173,7 +173,6 @@ def main(argv: list[str] | None = None) -> int:
     from wendel.bench import _table
     print(_table(rows))
     return 0
-
 
 
 def _main_states(p: argparse.ArgumentParser, a: argparse.Namespace) -> int:
