@@ -54,8 +54,12 @@ def test_a_replay_of_the_last_launch_takes_its_increments_and_iterations(cut):
     assert plain["exit"] == 0 and plain["increments"] >= 1
     ran = [sum(1 for _ in csv.DictReader((p / "newton.csv").open())) - 1 for p in launch][-plain["increments"]:]
     assert plain["iterations"] == sum(ran)
-    bad = newton_replay.replay(words, ["-newton_ls_memory", "0"])
-    assert bad["exit"] == 3 and bad["increments"] == 0
+    for opts, said in ((["-newton_ls_memory", "0"], "mechanics.idp: -newton_ls_memory must be >= 1, got 0"),
+                       (["-therm_omega", "1.5"], "thermal.idp: -therm_omega must be in (0, 1], got 1.5")):
+        with tempfile.TemporaryDirectory() as tmp:
+            bad = newton_replay.replay(words, opts, keep=Path(tmp) / "bad")
+            assert bad["exit"] == 3 and bad["increments"] == 0
+            assert said in (Path(tmp) / "bad" / "error.txt").read_text()
 
 
 def test_newton_rows_count_the_points_in_flow_and_their_switches(cut):
