@@ -1,18 +1,21 @@
 """The FE cut's Newton method on the states it meets: its tangent against finite differences of its residual away
 from the contact nodes (edp/lib/fdcheck.idp, which holds them: there the residual holds the gap, stick and slip
-rows), and the replay of a cut's last launch with other Newton options (`python -m wendel.bench.newton_replay`)."""
+rows), the replay of a cut's last launch with other Newton options (`python -m wendel.bench.newton_replay`), and
+the end of a Newton iteration that cycles (edp/lib/newtoncycle.idp, mechanics.idp's -newton_cycle)."""
 
 from __future__ import annotations
 
 import csv
 import json
 import statistics
+import subprocess
 import tempfile
 from pathlib import Path
 
 import pytest
 
 from conftest import WORKFLOWS
+from wendel import freefem
 from wendel.bench import newton_replay
 from wendel.bench.profile import last_launch
 
@@ -92,3 +95,92 @@ def test_a_step_from_an_accepted_state_is_the_step_the_run_made(cut):
     assert full["exit"] == 0 and full["increments"] == 1
     assert full["iterations"] == int(hist[n + 1]["newton_iterations"])
     assert bare["iterations"] + bare["failed_iterations"] != full["iterations"]
+
+
+# Relative residuals of Newton iterations of the steel cut (session 32, cutting-aisi1045-steady.toml, 3 digits): a
+# failed try that settled into a cycle of period 4 and ran to the 100th iteration, and two accepted increments that
+# wandered for 20 iterations before converging
+CYCLING = [4.78, 0.345, 0.358, 0.4, 0.296, 0.189, 0.167, 0.122, 0.145, 0.0923, 0.0742, 0.0566, 0.0589, 0.0576,
+           0.0682, 0.0526, 0.0703, 0.0551, 0.0679, 0.0528, 0.071, 0.0518, 0.0687, 0.053, 0.0669, 0.052, 0.0676,
+           0.0526, 0.0659, 0.052, 0.067, 0.0528, 0.066, 0.0519, 0.067, 0.0528, 0.066, 0.0519, 0.067, 0.0528, 0.066]
+WANDERING = [[3.9, 0.34, 0.51, 0.45, 0.37, 0.35, 0.57, 0.55, 0.48, 0.5, 0.42, 0.74, 0.61, 0.64, 0.58, 0.55, 0.51, 0.55,
+              0.4, 0.3, 0.21, 0.15, 0.11, 0.074, 0.038, 0.0057, 0.0002, 4.9e-07],
+             [1.5, 0.35, 0.53, 0.5, 0.47, 0.63, 0.73, 0.74, 0.63, 0.66, 0.68, 0.53, 0.42, 0.79, 0.42, 0.52, 0.42, 0.41,
+              0.18, 0.12, 0.21, 0.2, 0.19, 0.11, 0.076, 0.0041, 0.0011, 9.2e-05, 4.2e-06]]
+
+
+# an accepted increment that crept down by less than 1 % an iteration (16-19) and converged at iteration 45
+CREEPING = [9.724, 0.5375, 0.6334, 0.7345, 0.7302, 0.6215, 0.7083, 0.7135, 0.5869, 0.5551, 0.4855, 0.4913, 0.4602,
+            0.4474, 0.3639, 0.4034, 0.381, 0.3773, 0.3748, 0.3735, 0.3579, 0.3358, 0.3228, 0.3369]
+
+
+def _cycle_at(sequences: list[list[float]], it0: int = 0) -> list[tuple[int, int]]:
+    """(iteration, period) at which newtonCycleAt of edp/lib/newtoncycle.idp first finds a cycle in each sequence
+    (P = 4, 1 %; -1 and 0 when it finds none), run by FreeFEM."""
+    with tempfile.TemporaryDirectory() as tmp:
+        seq = Path(tmp) / "seq.txt"
+        seq.write_text(f"{len(sequences)}\n" + "".join(f"{len(s)} " + " ".join(map(repr, s)) + "\n" for s in sequences))
+        script = Path(tmp) / "cycle.edp"
+        script.write_text(f"""include "lib/newtoncycle.idp"
+ifstream f("{seq}");
+int m; f >> m;
+for (int s = 0; s < m; ++s) {{
+    int n; f >> n;
+    real[int] h(n);
+    for (int i = 0; i < n; ++i) f >> h[i];
+    int at = -1, per = 0;
+    for (int it = 0; it < n && at < 0; ++it) {{
+        newtonCycleAt(h, it, {it0}, 4, 0.01, per)
+        if (per > 0) at = it;
+    }}
+    cout << "cycle " << at << " " << per << endl;
+}}
+""")
+        p = subprocess.run(["FreeFem++-mpi", "-nw", "-v", "0", str(script)], env=freefem.environment(),
+                           capture_output=True, text=True, timeout=60)
+    assert p.returncode == 0, p.stdout + p.stderr
+    return [tuple(map(int, line.split()[1:])) for line in p.stdout.splitlines() if line.startswith("cycle ")]
+
+
+def test_a_newton_cycle_is_found_and_a_wandering_newton_that_converges_is_not():
+    # the cut's cycle of period 4 is found at iteration 40 (the 100-iteration try would have ended there), an exact
+    # alternation at iteration 10 (the earliest); a constant residual (no oscillation), the creeping and the two
+    # wandering increments that converged and a converging sequence never; iterations before the stage (it0) do not
+    # count
+    alternating = [1.0] + [0.5, 0.25] * 15
+    converging = [10.0 ** -k for k in range(14)]
+    assert _cycle_at([CYCLING, alternating, [0.3] * 12, CREEPING, *WANDERING, converging]) == \
+        [(40, 4), (10, 2), (-1, 0), (-1, 0), (-1, 0), (-1, 0), (-1, 0)]
+    assert _cycle_at([alternating], it0=8) == [(17, 2)]
+
+
+def test_the_steel_cut_gives_up_its_cycling_re_equilibration_at_its_40th_iteration(tmp_path):
+    # the steady steel scene as written (its path is chaotic: a shortened cut takes another one), its first 78
+    # increments (~100 s): the re-equilibration of increment 75 settles into a cycle of period 4 and ran to its
+    # 100th iteration before -newton_cycle (measured in sessions 30 and 32, on an AMD EPYC and an Intel Xeon: the
+    # same path to the last digit); now it is given up at the 40th and retried in 8 stages, and the increments the
+    # run accepts are those it accepted before (session 32: history.csv the same to the last digit)
+    from wendel.cutting.fe import fe_scene
+    from wendel.loop.quasistatic import run_scene
+    from wendel.scene import load
+    path = WORKFLOWS / "cutting-aisi1045-steady.toml"
+    said = []
+    run = run_scene(fe_scene(load(path), 1.0), path, tmp_path / "run", False, said.append,
+                    until=lambda state: state.last[0] >= 78)
+    said75 = ("  increment 75: Newton cycles (its residuals repeat every 4 iterations) in the re-equilibration; again"
+              " in 8 stages")
+    assert said75 in said, [m for m in said if "increment 7" in m]
+    tried = list(csv.DictReader(next((run / "failed-attempts").glob("inc-0075-*-newton.csv")).open()))
+    h = [float(r["relative_residual"]) for r in tried]
+    assert len(h) - 1 == 40 and all(abs(h[-1 - j] - h[-5 - j]) <= 0.01 * h[-1 - j] for j in range(12)), h
+    assert max(h[-4:]) > 1.02 * min(h[-4:])
+
+
+def test_newton_cycle_options_out_of_range_are_refused(cut):
+    # -newton_cycle and -newton_cycle_tol out of range: error.txt names the file and the option
+    words = last_launch(cut)
+    for opts, said in ((["-newton_cycle", "-1"], "mechanics.idp: -newton_cycle must be >= 0, got -1"),
+                       (["-newton_cycle_tol", "1.5"], "mechanics.idp: -newton_cycle_tol must be in (0, 1), got 1.5")):
+        with tempfile.TemporaryDirectory() as tmp:
+            bad = newton_replay.replay(words, opts, keep=Path(tmp) / "bad")
+            assert bad["exit"] == 3 and said in (Path(tmp) / "bad" / "error.txt").read_text()
