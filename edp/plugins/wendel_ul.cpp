@@ -32,11 +32,24 @@
 //       (r, z)) added to D (as wendelUlTangent's): c = [c2, c3] (2 arrays), X = [f11, f12, f21, f22, p, q, V11, V12,
 //       V22, beta] of the trial (10 arrays, ulTrial); S, N, G full d x d (d = 2, or 3 in (r, z)). The array code's
 //       operations in its order, per cell: the same D bit for bit (tests/test_plast_compiled.py). Returns n.
+//   long wendelUlMatrix2(matrix K, mesh Th, real[int] D, real[int] fix, real[int] Fc, real[int] G, real[int] sinv);
+//       The plane (2D, not (r, z)) P1 Newton matrix of the updated-Lagrangian kinematics: the varf vTangent
+//       (mechanics.idp, kinematics.idp's tangentWork), K = sum over the triangles of |T| D_{pm,rn} d_m v_p d_n du_r
+//       (one point: D and the P1 gradients are constant per triangle; D as wendelUlTangent's with the 4 gradient
+//       components active, 16 arrays of Th.nt values) and, when Fc is not empty, F-bar's patch term of
+//       kinematics-fbar.idp, Y' diag(sinv) Z on the free rows (Y and Z its varfs ulVY, ulVZ: the vertex patches'
+//       sums of |T| / 3 times (Fc_(2r) d_x + Fc_(2r+1) d_y) du_r and (G_(0r) d_x + G_(1r) d_y) du_r; Fc and G 4
+//       arrays of Th.nt values, sinv one value per vertex); the rows of the DoFs with fix = 1 identity rows (the
+//       varf's tgv = -1). DoF 2 a + component of vertex a. The same matrix as the varfs and wendelFbarAdd to
+//       round-off (other orders of the sums; kinematics.idp's -ul_tangent_compiled 2 records the difference), in
+//       one pass instead of three varfs and a product. Returns the entries.
 #include "ff++.hpp"
 #include "AFunction_ext.hpp"
 #include "wendel_step.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <vector>
 
 namespace {
@@ -416,6 +429,187 @@ long wendelUlExact2(KN<double>* const& pS, KN<double>* const& pN, KN<double>* co
     return n;
 }
 
+
+// The CSR pattern of the Newton matrix of the P1 vector space of a 2D mesh (2 DoFs a vertex, DoF 2 a + c): with
+// F-bar every pair of DoFs of two vertices that share a vertex patch (the patch term couples a patch's DoFs: the
+// vertices at most two edges apart), else every pair of a triangle's vertices. Kept with its addresses for the
+// next call on the same triangles (the Newton steps of a launch, whose mesh moves but keeps its triangles):
+// tri[9 k + 3 i + j], where vertex j's block sits in vertex i's row of triangle k; for each vertex a, its patch
+// (the vertices of its triangles, sorted) and pair[q], where patch vertex jj's block sits in patch vertex ii's row.
+struct Pattern2 {
+    long nv = -1, nt = -1;
+    bool fbar = false;
+    uint64_t key = 0;
+    std::vector<int> rowptr, col, tri;
+    std::vector<int> patchPtr, patch, pairPtr, pair, cellPtr, cell;
+} pat2;
+
+uint64_t triangles(const Mesh& Th)
+{
+    uint64_t h = 1469598103934665603ull;
+    for (long k = 0; k < Th.nt; ++k)
+        for (int i = 0; i < 3; ++i) h = (h ^ (uint64_t)Th(Th[k][i])) * 1099511628211ull;
+    return h;
+}
+
+int where(const std::vector<int>& cols, int lo, int hi, int b)     // the block of vertex b in [lo, hi) (in vertices)
+{
+    return (int)(std::lower_bound(cols.begin() + lo, cols.begin() + hi, b) - cols.begin()) - lo;
+}
+
+void ensurePattern2(const Mesh& Th, bool fbar)
+{
+    const uint64_t key = triangles(Th);
+    if (pat2.nv == Th.nv && pat2.nt == Th.nt && pat2.key == key && pat2.fbar == fbar) return;
+    const long nv = Th.nv, nt = Th.nt;
+    std::vector<std::vector<int>> nb(nv), cells(nv);
+    for (long k = 0; k < nt; ++k)
+        for (int i = 0; i < 3; ++i) {
+            cells[Th(Th[k][i])].push_back((int)k);
+            for (int j = 0; j < 3; ++j) nb[Th(Th[k][i])].push_back(Th(Th[k][j]));
+        }
+    for (auto& v : nb) {
+        std::sort(v.begin(), v.end());
+        v.erase(std::unique(v.begin(), v.end()), v.end());
+    }
+    std::vector<std::vector<int>> row(nv);          // the vertices of each vertex's row
+    for (long a = 0; a < nv; ++a) {
+        if (!fbar) { row[a] = nb[a]; continue; }
+        for (int b : nb[a]) row[a].insert(row[a].end(), nb[b].begin(), nb[b].end());
+        std::sort(row[a].begin(), row[a].end());
+        row[a].erase(std::unique(row[a].begin(), row[a].end()), row[a].end());
+    }
+    std::vector<int> vptr(nv + 1, 0), vcol;          // the rows in vertices
+    for (long a = 0; a < nv; ++a) {
+        vptr[a + 1] = vptr[a] + (int)row[a].size();
+        vcol.insert(vcol.end(), row[a].begin(), row[a].end());
+    }
+    pat2.rowptr.assign(2 * nv + 1, 0);
+    for (long a = 0; a < nv; ++a)
+        for (int c = 0; c < 2; ++c) pat2.rowptr[2 * a + c + 1] = pat2.rowptr[2 * a + c] + 2 * (int)row[a].size();
+    pat2.col.resize(pat2.rowptr[2 * nv]);
+    for (long a = 0; a < nv; ++a)
+        for (int c = 0; c < 2; ++c) {
+            int q = pat2.rowptr[2 * a + c];
+            for (int b : row[a]) { pat2.col[q++] = 2 * b; pat2.col[q++] = 2 * b + 1; }
+        }
+    pat2.tri.resize(9 * nt);
+    for (long k = 0; k < nt; ++k)
+        for (int i = 0; i < 3; ++i) {
+            const int a = Th(Th[k][i]);
+            for (int j = 0; j < 3; ++j) pat2.tri[9 * k + 3 * i + j] = where(vcol, vptr[a], vptr[a + 1], Th(Th[k][j]));
+        }
+    pat2.patchPtr.assign(nv + 1, 0);
+    pat2.pairPtr.assign(nv + 1, 0);
+    pat2.cellPtr.assign(nv + 1, 0);
+    pat2.patch.clear();
+    pat2.pair.clear();
+    pat2.cell.clear();
+    if (fbar)
+        for (long a = 0; a < nv; ++a) {
+            pat2.patch.insert(pat2.patch.end(), nb[a].begin(), nb[a].end());
+            pat2.patchPtr[a + 1] = (int)pat2.patch.size();
+            for (int bi : nb[a])
+                for (int bj : nb[a]) pat2.pair.push_back(where(vcol, vptr[bi], vptr[bi + 1], bj));
+            pat2.pairPtr[a + 1] = (int)pat2.pair.size();
+            pat2.cell.insert(pat2.cell.end(), cells[a].begin(), cells[a].end());
+            pat2.cellPtr[a + 1] = (int)pat2.cell.size();
+        }
+    pat2.nv = nv;
+    pat2.nt = nt;
+    pat2.key = key;
+    pat2.fbar = fbar;
+}
+
+long wendelUlMatrix2(Matrice_Creuse<double>* const& K, const Mesh* const& pTh, KN<double>* const& pD,
+                     KN<double>* const& fix, KN<double>* const& pFc, KN<double>* const& pG, KN<double>* const& sinv)
+{
+    const Mesh& Th = *pTh;
+    const long nt = Th.nt, nv = Th.nv, n = 2 * nv;
+    const KN<double>& D = *pD;
+    const bool fbar = pFc->N() > 0;
+    if (D.N() != 16 * nt) ExecError("wendelUlMatrix2: D needs 16 values per triangle");
+    if (fix->N() != n) ExecError("wendelUlMatrix2: fix needs one value per DoF (2 per vertex)");
+    if (fbar && (pFc->N() != 4 * nt || pG->N() < 4 * nt || sinv->N() != nv))
+        ExecError("wendelUlMatrix2: F-bar needs Fc and G with 4 values per triangle, sinv one per vertex");
+    ensurePattern2(Th, fbar);
+    std::vector<double> val(pat2.col.size(), 0.0);
+    std::vector<double> grad(6 * nt);            // the barycentric gradients, g[i][m] at 6 k + 2 i + m
+    for (long k = 0; k < nt; ++k) {
+        const Triangle& T = Th[k];
+        const double area = T.area;
+        double* g = &grad[6 * k];
+        for (int i = 0; i < 3; ++i) {
+            const R2 h = T.H(i);
+            g[2 * i] = h.x;
+            g[2 * i + 1] = h.y;
+        }
+        double Dk[16];
+        for (int q = 0; q < 16; ++q) Dk[q] = area * D[q * nt + k];
+        const int* off = &pat2.tri[9 * k];
+        for (int i = 0; i < 3; ++i) {
+            const int a = Th(T[i]);
+            for (int j = 0; j < 3; ++j) {
+                const int o = 2 * off[3 * i + j];
+                for (int p = 0; p < 2; ++p) {
+                    double* row = &val[pat2.rowptr[2 * a + p] + o];
+                    for (int r = 0; r < 2; ++r) {
+                        const double* d = &Dk[8 * p + 2 * r];      // D_{pm,rn} at 8 p + 4 m + 2 r + n
+                        row[r] += g[2 * i] * (d[0] * g[2 * j] + d[1] * g[2 * j + 1])
+                                  + g[2 * i + 1] * (d[4] * g[2 * j] + d[5] * g[2 * j + 1]);
+                    }
+                }
+            }
+        }
+    }
+    if (fbar) {      // + Y' diag(sinv) Z on the free rows: Y(a, (b, r)) = sum_(k at a, b) |k| / 3 q_k(b, r), Z likewise w_k
+        const KN<double>& Fc = *pFc;
+        const KN<double>& G = *pG;
+        std::vector<double> y, z;
+        for (long a = 0; a < nv; ++a) {
+            const int p0 = pat2.patchPtr[a], np = pat2.patchPtr[a + 1] - p0;
+            y.assign(2 * np, 0.0);
+            z.assign(2 * np, 0.0);
+            for (int t = pat2.cellPtr[a]; t < pat2.cellPtr[a + 1]; ++t) {
+                const long k = pat2.cell[t];
+                const Triangle& T = Th[k];
+                const double w = T.area / 3.0, *g = &grad[6 * k];
+                for (int i = 0; i < 3; ++i) {
+                    const int bi = (int)(std::lower_bound(pat2.patch.begin() + p0, pat2.patch.begin() + p0 + np,
+                                                          (int)Th(T[i])) - pat2.patch.begin()) - p0;
+                    for (int r = 0; r < 2; ++r) {
+                        y[2 * bi + r] += w * (Fc[(2 * r) * nt + k] * g[2 * i] + Fc[(2 * r + 1) * nt + k] * g[2 * i + 1]);
+                        z[2 * bi + r] += w * (G[r * nt + k] * g[2 * i] + G[(2 + r) * nt + k] * g[2 * i + 1]);
+                    }
+                }
+            }
+            const double s = (*sinv)[a];
+            const int* pr = &pat2.pair[pat2.pairPtr[a]];
+            for (int ii = 0; ii < np; ++ii) {
+                const int bi = pat2.patch[p0 + ii];
+                for (int c = 0; c < 2; ++c) {
+                    const double yc = y[2 * ii + c];
+                    if ((*fix)[2 * bi + c] > 0.5 || yc == 0.0) continue;
+                    double* row = &val[pat2.rowptr[2 * bi + c]];
+                    for (int jj = 0; jj < np; ++jj) {
+                        const int o = 2 * pr[ii * np + jj];
+                        row[o] += yc * (s * z[2 * jj]);
+                        row[o + 1] += yc * (s * z[2 * jj + 1]);
+                    }
+                }
+            }
+        }
+    }
+    for (long r = 0; r < n; ++r)
+        if ((*fix)[r] > 0.5)
+            for (int q = pat2.rowptr[r]; q < pat2.rowptr[r + 1]; ++q) val[q] = pat2.col[q] == r ? 1.0 : 0.0;
+    K->resize(n, n);
+    HashMatrix<int, double>* H = K->pHM();
+    if (!H) ExecError("wendelUlMatrix2: K is not a sparse matrix");
+    H->set((int)n, (int)n, 0, val.size(), pat2.rowptr.data(), pat2.col.data(), val.data(), 0, 1);
+    return (long)val.size();
+}
+
 }  // namespace
 
 static void Load_Init()
@@ -426,6 +620,9 @@ static void Load_Init()
     Global.Add("wendelUlTangent", "(",
                new OneOperator8_<long, KN<double>*, KN<double>*, KN<double>*, KN<double>*, KN<double>*, KN<long>*,
                                  KN<double>*, KN<double>*>(wendelUlTangent));
+    Global.Add("wendelUlMatrix2", "(",
+               new OneOperator7_<long, Matrice_Creuse<double>*, const Mesh*, KN<double>*, KN<double>*, KN<double>*,
+                                 KN<double>*, KN<double>*>(wendelUlMatrix2));
     Global.Add("wendelUlExact2", "(",
                new OneOperator8_<long, KN<double>*, KN<double>*, KN<double>*, KN<double>*, KN<double>*, KN<double>*,
                                  KN<long>*, KN<double>*>(wendelUlExact2));
