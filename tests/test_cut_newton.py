@@ -154,28 +154,6 @@ def test_a_newton_cycle_is_found_and_a_wandering_newton_that_converges_is_not():
     assert _cycle_at([alternating], it0=8) == [(17, 2)]
 
 
-def test_the_steel_cut_gives_up_its_cycling_re_equilibration_at_its_40th_iteration(tmp_path):
-    # the steady steel scene as written (its path is chaotic: a shortened cut takes another one), its first 78
-    # increments (~100 s): the re-equilibration of increment 75 settles into a cycle of period 4 and ran to its
-    # 100th iteration before -newton_cycle (measured in sessions 30 and 32, on an AMD EPYC and an Intel Xeon: the
-    # same path to the last digit); now it is given up at the 40th and retried in 8 stages, and the increments the
-    # run accepts are those it accepted before (session 32: history.csv the same to the last digit)
-    from wendel.cutting.fe import fe_scene
-    from wendel.loop.quasistatic import run_scene
-    from wendel.scene import load
-    path = WORKFLOWS / "cutting-aisi1045-steady.toml"
-    said = []
-    run = run_scene(fe_scene(load(path), 1.0), path, tmp_path / "run", False, said.append,
-                    until=lambda state: state.last[0] >= 78)
-    said75 = ("  increment 75: Newton cycles (its residuals repeat every 4 iterations) in the re-equilibration; again"
-              " in 8 stages")
-    assert said75 in said, [m for m in said if "increment 7" in m]
-    tried = list(csv.DictReader(next((run / "failed-attempts").glob("inc-0075-*-newton.csv")).open()))
-    h = [float(r["relative_residual"]) for r in tried]
-    assert len(h) - 1 == 40 and all(abs(h[-1 - j] - h[-5 - j]) <= 0.01 * h[-1 - j] for j in range(12)), h
-    assert max(h[-4:]) > 1.02 * min(h[-4:])
-
-
 def test_newton_cycle_options_out_of_range_are_refused(cut):
     # -newton_cycle and -newton_cycle_tol out of range: error.txt names the file and the option
     words = last_launch(cut)
