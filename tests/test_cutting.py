@@ -240,6 +240,41 @@ def test_chip_thickness_of_a_chip_along_the_rake_face():
         chip.chip_thickness(pts, [1e-3, 0.0], rake, band=(3e-3, 4e-3))
 
 
+def _strip(s0, s1, d0, d1, rake, n=8):
+    """A structured triangulation of the strip s0..s1 along and d0..d1 off a rake face through the origin."""
+    along, normal = np.array([math.sin(rake), math.cos(rake)]), np.array([-math.cos(rake), math.sin(rake)])
+    S, D = np.meshgrid(np.linspace(s0, s1, n + 1), np.linspace(d0, d1, 5), indexing="ij")
+    pts = np.outer(S.ravel(), along) + np.outer(D.ravel(), normal)
+    k = lambda i, j: i * 5 + j
+    tri = [[k(i, j), k(i + 1, j), k(i + 1, j + 1)] for i in range(n) for j in range(4)] + \
+          [[k(i, j), k(i + 1, j + 1), k(i, j + 1)] for i in range(n) for j in range(4)]
+    return pts, np.array(tri)
+
+
+def test_chip_thickness_counts_the_first_layer_only_when_the_chip_curls_back_over_the_band():
+    """A chip of 160 um on the rake face and, 150 um beyond it, 100 um of the same chip curled back over the band
+    (the long titanium cut of session 33): the free surface points of both lie in the band; without the mesh the
+    median takes the curled layer's surfaces (2-3 times the chip, as that cut's record did), with it the first
+    layer's back surface only."""
+    rake, t2 = math.radians(-7), 160e-6
+    chip_pts, chip_tri = _strip(0.0, 300e-6, 0.0, t2, rake)
+    curl_pts, curl_tri = _strip(50e-6, 250e-6, t2 + 150e-6, t2 + 250e-6, rake)
+    nodes = np.vstack([chip_pts, curl_pts])
+    tri = np.vstack([chip_tri, curl_tri + len(chip_pts)])
+    along, normal = np.array([math.sin(rake), math.cos(rake)]), np.array([-math.cos(rake), math.sin(rake)])
+    d = nodes @ normal
+    free = np.isclose(d, t2) | np.isclose(d, t2 + 150e-6) | np.isclose(d, t2 + 250e-6)
+    band = (100e-6, 200e-6)
+    old, _ = chip.chip_thickness(nodes[free], [0.0, 0.0], rake, band)
+    assert old > 1.9 * t2
+    new, spread = chip.chip_thickness(nodes[free], [0.0, 0.0], rake, band, mesh=(nodes, tri))
+    assert new == pytest.approx(t2, rel=1e-9) and spread < 1e-12
+    assert chip.first_layer_end(nodes, tri, [0.0, 0.0], rake, 150e-6) == pytest.approx(t2, rel=1e-9)
+    alone, _ = chip.chip_thickness(chip_pts[np.isclose(chip_pts @ normal, t2)], [0.0, 0.0], rake, band,
+                                   mesh=(chip_pts, chip_tri))
+    assert alone == pytest.approx(t2, rel=1e-9)       # one layer: the same points as without the mesh
+
+
 def test_steady_state_of_a_settling_cut():
     x = np.linspace(0.0, 2e-3, 201)                 # cut length [m]
     fc = 575.0 * (1 - 0.5 * np.exp(-x / 0.2e-3)) * (1 + 0.004 * np.sin(x / 0.03e-3))

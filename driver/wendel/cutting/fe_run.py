@@ -11,7 +11,8 @@ and record and writes ``cutting.csv`` and ``cutting.json`` in the run folder, an
 - ``contact_length_m``: the largest distance from the tool tip, along the rake face, of a node in contact
   (``friction_state`` > 0) [m];
 - ``chip_thickness_m``: :func:`wendel.cutting.chip.chip_thickness` of the free boundary nodes above 1.1 h
-  and between 1 and 2 h up the rake face from the tip (NaN while the chip is shorter than that);
+  and between 1 and 2 h up the rake face from the tip, of the chip's first layer on the rake face's normal (a
+  chip curled back over that band is not counted twice) (NaN while the chip is shorter than that);
 - ``shear_angle_deg``: from the chip ratio (:func:`wendel.cutting.chip.shear_angle`; NaN without a chip thickness);
 - ``max_T_primary_K``, ``max_T_secondary_K``: the largest temperature of the primary and the secondary (tool-chip)
   shear zone (:mod:`wendel.cutting.fe_zones`: within 0.25 h of the shear plane and more than 0.2 h from the tool;
@@ -140,7 +141,7 @@ def measure(points: np.ndarray, cells: np.ndarray, state: np.ndarray, tip: np.nd
     free = _boundary_nodes(cells)
     free = free[~active[free] & (points[free, 1] > 1.1 * h)]      # the chip's back surface: risen above the layer
     try:
-        thickness, _ = chip.chip_thickness(points[free], tip, rake, (h, 2 * h))
+        thickness, _ = chip.chip_thickness(points[free], tip, rake, (h, 2 * h), mesh=(points, cells))
     except ValueError:
         thickness = float("nan")
     return {"chip_rise": rise, "contact_length": max(length, 0.0), "chip_thickness": thickness}
