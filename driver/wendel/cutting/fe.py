@@ -52,6 +52,7 @@ from ..scene.schema import Scene
 from .tool import tool_polygon
 
 MM = 1e3          # m -> mm
+TRIM_ABOVE = 1.05  # cutting.trim_chip: only material above the uncut layer's top (h above the tip) and a little more
 MPA = 1e-6        # Pa -> MPa
 GAP = 0.02        # the tool starts this fraction of h in front of the step face
 RELAX_STEPS = 4   # the re-equilibration after a remesh releases the transferred out-of-balance in 4 stages
@@ -155,6 +156,10 @@ def fe_scene(scene, travel: float = 1.0) -> Scene:
         remesh["smooth_features"] = smooth
     if c.snap_to_tool:
         remesh["snap_to_tool"] = True
+    if c.trim_chip is not None:      # the chip's far end cut off (a chip that curls back onto the workpiece)
+        remesh["trim"] = {"point": list(tool["tip"]), "radius": c.trim_chip * c.uncut_thickness * MM,
+                          "above": tool["tip"][1] + TRIM_ABOVE * c.uncut_thickness * MM, "label": "free_surface"}
+        remesh["zones_follow"] = "tool"
     if c.edge_size is not None:      # graded: fine at the edge, coarse far away (size_zones)
         remesh["h"] = FAR * fine * g.h * MM
         remesh["zones"] = size_zones(c, tool["tip"], fine * g.h * MM, (every or 1) * cut / steps)

@@ -199,7 +199,8 @@ def _zone_field(gmsh, zone, h):
 
 
 def remesh(points_deformed, mesh_in_path, out_path, h, size_indicator=None, h_min=None,
-           feature_angle=30.0, optimize=True, algorithm_3d=10, zones=None, algorithm_2d=None, smooth_features=0.0):
+           feature_angle=30.0, optimize=True, algorithm_3d=10, zones=None, algorithm_2d=None, smooth_features=0.0,
+           trim=None):
     """Mesh the deformed body anew from its boundary; write MSH 2.2 with the same labels.
 
     Parameters
@@ -233,6 +234,9 @@ def remesh(points_deformed, mesh_in_path, out_path, h, size_indicator=None, h_mi
     smooth_features : float
         2D: old boundary nodes between neighbours closer than the local target size that stand less than this
         share of it off their chord are dropped before meshing (:mod:`wendel.remesh.features`); 0: none.
+    trim : dict, optional
+        2D: material left out of the new mesh (:func:`trim_cells`: ``point``, ``radius``, ``above``, ``label``,
+        the boundary name its cut edges get); the report then has ``trimmed_elements`` and ``trimmed_measure``.
 
     Returns
     -------
@@ -269,6 +273,22 @@ def remesh(points_deformed, mesh_in_path, out_path, h, size_indicator=None, h_mi
         if np.any(quality.signed_measure(pts, cells) <= 0):
             raise ValueError(f"{mesh_in_path}: the faces cut along '{OPENED}' have opened so far that the mesh "
                              "glued at their mean position inverts: remesh from an earlier increment")
+    trimmed = (0, 0.0)
+    if trim is not None and (dim != 2 or cut is not None):
+        raise ValueError("remesh.trim is for 2D bodies without opened faces")
+    if trim is not None:
+        keep = trim_cells(pts, cells, trim["point"], trim["radius"], trim["above"])
+        if not keep.all():
+            names = meshfile.read(mesh_in_path).field_data
+            if trim["label"] not in names:
+                raise ValueError(f"{mesh_in_path}: remesh.trim.label = {trim['label']!r} is none of the mesh's "
+                                 f"names ({', '.join(sorted(names))})")
+            trimmed = (int((~keep).sum()), float(meas_old[~keep].sum()))
+            cells = cells[keep]
+            inner = {tuple(sorted(f)) for f in boundary_facets(cells).tolist()} - \
+                {tuple(sorted(f)) for f in facets.tolist()}       # the cut's edges: boundary now, unlabelled
+            facets = np.vstack([facets, np.array(sorted(inner), dtype=facets.dtype).reshape(-1, 2)])
+            facet_tags = np.concatenate([facet_tags, np.full(len(inner), int(names[trim["label"]][0]))])
     bf = boundary_facets(cells)
     labels = _label_facets(bf, facets, facet_tags)
     h_min = h / 4 if h_min is None else h_min
@@ -362,7 +382,34 @@ def remesh(points_deformed, mesh_in_path, out_path, h, size_indicator=None, h_mi
         "mean_sicn": q["mean"],
         "inverted": q["inverted"],
         "seconds": time.perf_counter() - t0,
+        **({"trimmed_elements": trimmed[0], "trimmed_measure": trimmed[1]} if trim is not None else {}),
     }
+
+
+def trim_cells(points, cells, point, radius: float, above: float) -> np.ndarray:
+    """Which 2D ``cells`` (triangles of ``points``) a trimmed mesh keeps: not those whose centre lies farther
+    than ``radius`` from ``point`` and above ``above`` (y), and of the rest only the largest body (cells joined by
+    edges, by area): a piece the cut leaves hanging goes too.
+
+    >>> pts = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0], [0.0, 2.0], [1.0, 2.0], [0.0, 3.0]])
+    >>> tri = np.array([[0, 1, 2], [0, 2, 3], [3, 2, 5], [3, 5, 4], [4, 5, 6]])
+    >>> trim_cells(pts, tri, [0.5, 0.0], 1.6, 0.5).tolist()       # the top two go: far and above 0.5
+    [True, True, True, False, False]
+    >>> trim_cells(pts, tri, [0.5, 0.0], 1.6, 5.0).tolist()       # nothing above 5
+    [True, True, True, True, True]
+    """
+    p = np.asarray(points, dtype=float)[:, :2]
+    c = p[cells].mean(axis=1)
+    out = (np.hypot(c[:, 0] - point[0], c[:, 1] - point[1]) > radius) & (c[:, 1] > above)
+    keep = ~out
+    if not out.any() or not keep.any():
+        return keep
+    kept = np.flatnonzero(keep)
+    body = bodies.body_index(cells[kept])
+    area = np.abs(quality.signed_measure(np.hstack([p, np.zeros((len(p), 1))]), cells[kept]))
+    largest = np.argmax(np.bincount(body, weights=area))
+    keep[kept[body != largest]] = False
+    return keep
 
 
 def _mean_of_copies(pts, rep):

@@ -204,6 +204,17 @@ def zones_at(r, inc_dir) -> list[dict]:
             for z in r.zones]
 
 
+def trim_at(r, inc_dir) -> dict | None:
+    """``remesh.trim`` of ``remesh`` (``r``) for the remesh after increment ``inc_dir`` (its point moved with the tool
+    as the zones are, :func:`zones_at`), as :func:`wendel.remesh.mesher.remesh` takes it; None without one."""
+    t = r.trim
+    if t is None:
+        return None
+    shift = placement(inc_dir)[0] if r.zones_follow == "tool" else np.zeros(3)
+    return {"point": [t.point[0] + shift[0], t.point[1] + shift[1]], "radius": t.radius,
+            "above": t.above + shift[1], "label": t.label}
+
+
 def placement(inc_dir) -> tuple[np.ndarray, float]:
     """The tool's placement at increment ``inc_dir``: its shift (``tool_x``, ``tool_y``, ``tool_z`` of its
     record.json, 0 where missing or empty) and turn (``tool_angle``)."""

@@ -32,7 +32,7 @@ import numpy as np
 
 from .again import AGAIN, made_or_failed
 from .batch import first_steps
-from .snap import onto_tool, tool_at, zones_at       # the tool where it stands at a remesh (numpy only)
+from .snap import onto_tool, tool_at, trim_at, zones_at       # the tool where it stands at a remesh (numpy only)
 from . import limit, quality   # mesher (meshio, gmsh), transfer (scipy) when a run remeshes: one that does not: none
 from ..results import vtu
 
@@ -88,7 +88,7 @@ def remesh_state(inc_dir: Path, mesh_old: Path, ubase_old: np.ndarray | None, di
                  mesh_new: Path, state_new: Path, h: float, h_min: float, indicator: str,
                  mu: float | None = None, axisymmetric: bool = False, make_mesh=None,
                  deformed: bool = True, zones: list[dict] | None = None, algorithm_2d: int | None = None,
-                 smooth_features: float = 0.0, tool: dict | None = None) -> dict:
+                 smooth_features: float = 0.0, tool: dict | None = None, trim: dict | None = None) -> dict:
     """Mesh the deformed body of increment ``inc_dir`` anew and write the transferred state.
 
     Writes ``mesh_new`` and, in ``state_new``, ``u.node.txt`` (zeros), ``ubase.txt``, ``eps0.txt`` and the
@@ -100,7 +100,8 @@ def remesh_state(inc_dir: Path, mesh_old: Path, ubase_old: np.ndarray | None, di
     (small strain: the new mesh is made from the original geometry); ``zones``: boxes of finer size
     (:func:`wendel.remesh.mesher.remesh`); ``smooth_features``: :mod:`wendel.remesh.features`; ``tool``: a 2D
     rigid tool where it stands (``vertices``, ``radii``): new boundary nodes inside it are moved onto its surface
-    (:mod:`wendel.remesh.snap`).
+    (:mod:`wendel.remesh.snap`); ``trim``: material left out of the new mesh (2D, ``remesh.trim`` where it stands,
+    :func:`wendel.remesh.snap.trim_at`).
     """
     from . import mesher, transfer
 
@@ -118,8 +119,8 @@ def remesh_state(inc_dir: Path, mesh_old: Path, ubase_old: np.ndarray | None, di
     with _quiet_stdout():
         info = (make_mesh or mesher.remesh)(xd, mesh_old, mesh_new, h, size_indicator=size_ind, h_min=h_min,
                                             **({"zones": zones} if zones else {}), **{k: v for k, v in (
-                                                ("algorithm_2d", algorithm_2d), ("smooth_features", smooth_features))
-                                                if v})
+                                                ("algorithm_2d", algorithm_2d), ("smooth_features", smooth_features),
+                                                ("trim", trim)) if v})
     t1 = time.perf_counter()
     Y, new_cells = vtu.read_mesh(mesh_new, dimension)
     Y = Y[:, :dimension]
@@ -131,7 +132,8 @@ def remesh_state(inc_dir: Path, mesh_old: Path, ubase_old: np.ndarray | None, di
               "min_quality_before": before["min"], "inverted_before": before["inverted"],
               "min_quality_after": info["min_sicn"], "measure_old": info["measure_old"],
               "measure_new": info["measure_new"], "remesh_seconds": t1 - t0,
-              "boundary_nodes_smoothed": info.get("boundary_nodes_smoothed", 0)}
+              "boundary_nodes_smoothed": info.get("boundary_nodes_smoothed", 0),
+              **{k: info[k] for k in ("trimmed_elements", "trimmed_measure") if k in info}}
     report.update(snapped)
     # Every field goes through one point location: nodal fields as they are, cell fields recovered
     # to nodes (volume-weighted, integral kept), all stacked, interpolated once, split again.
@@ -288,7 +290,8 @@ def maybe_remesh(scene, files, state, dimension: int, progress, again: int = 0, 
         files.root / state_dir, h, r.h_min or h / 3, r.indicator, mu=scene.material.E / (2 * (1 + scene.material.nu)),
         axisymmetric=scene.elasticity.plane == "axisymmetric", zones=zones_at(r, files.fem / f"inc-{inc:04d}"),
         algorithm_2d=algorithm, smooth_features=r.smooth_features, make_mesh=limit.mesher(r.mesh_timeout),
-        tool=tool_at(scene, files.fem / f"inc-{inc:04d}") if r.snap_to_tool else None), k, inc, lf, q, files.root,
+        tool=tool_at(scene, files.fem / f"inc-{inc:04d}") if r.snap_to_tool else None,
+        trim=trim_at(r, files.fem / f"inc-{inc:04d}")), k, inc, lf, q, files.root,
         tries, progress)
     rep.update({"remesh": k, "after_increment": inc, "load_factor": lf, "dimension": dimension,
                 "algorithm_2d_tries": again + used, "after_failed_step": failed,

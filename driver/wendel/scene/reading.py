@@ -98,6 +98,9 @@ def boundary_names(scene: Scene) -> list[tuple[str, str]]:
     thermal = getattr(scene, "thermal", None)
     if thermal is not None:
         keys += [(f"thermal.boundary.{n}", n) for n in thermal.boundary]
+    trim = scene.remesh.trim if scene.remesh is not None else None
+    if trim is not None:
+        keys.append(("remesh.trim.label", trim.label))
     return keys
 
 

@@ -284,6 +284,25 @@ class RemeshZone(Strict):
         return v
 
 
+class RemeshTrim(Strict):
+    """Material the new meshes leave out (2D, ``wendel.remesh.mesher``): the cells whose centre lies farther than
+    ``radius`` from ``point`` and above ``above``; of what is left, the largest connected body is meshed, its new
+    edges labelled ``label``. For a chip that curls back onto the workpiece: its far end is cut off."""
+
+    point: list[float] = Field(..., min_length=2, max_length=2, description="centre [x, y] [m] (with "
+                               "remesh.zones_follow = tool, written for the tool at load factor 0 and moved with it)")
+    radius: float = Field(..., gt=0, description="material farther than this from the point is left out [m]")
+    above: float = Field(..., description="only material whose cell centre lies above this y [m]")
+    label: str = Field(..., description="the boundary name the cut edges get (one of the mesh's boundaries)")
+
+    @field_validator("point")
+    @classmethod
+    def _finite(cls, v):
+        if any(not abs(x) < 1e30 for x in v):
+            raise ValueError("remesh.trim.point: finite numbers")
+        return v
+
+
 class Remesh(Strict):
     """Remeshing of the deformed body (its presence enables it): when the deformed mesh's quality falls
     below the threshold, gmsh meshes the deformed configuration anew and the state is transferred."""
@@ -324,6 +343,8 @@ class Remesh(Strict):
     zones_follow: Literal["body", "tool"] = Field("body", description="body: the zones stand where they are "
                                                   "written; tool: they move with contact.path (written for "
                                                   "the tool at load factor 0)")
+    trim: Optional[RemeshTrim] = Field(None, description="2D: material the new meshes leave out (remesh.trim: "
+                                       "point, radius, above, label); it moves with the tool as the zones do")
 
 
 class Reference(Strict):

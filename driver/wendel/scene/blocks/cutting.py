@@ -113,6 +113,10 @@ class Cutting(BaseModel):
     snap_to_tool: bool = Field(False, description="FE: the remeshes move new boundary nodes that fall inside the "
                                "tool (on old edges of the machined surface that cut its rounded edge: 1.3-3.4 um "
                                "deep on the F-bar steel cut, measured) onto its surface, as remesh.snap_to_tool")
+    trim_chip: Optional[float] = Field(None, gt=0, description="FE: the remeshes cut off the chip's material farther "
+                                       "than this many uncut thicknesses from the tool's tip and above the uncut "
+                                       "layer (remesh.trim), so that a chip that curls back does not come down onto "
+                                       "the workpiece (the model has no self-contact) [1]; default: the whole chip")
     steady_tol: float = Field(0.02, gt=0, le=1, description="FE: the steady state is where F_c, F_t and the chip "
                               "thickness (their remesh-cycle means) stay within this relative spread over "
                               "steady_length of travel [1] (wendel.cutting.fe_steady)")
