@@ -58,10 +58,8 @@ def test_a_trimmed_remesh_meshes_what_is_left_and_labels_the_cut_as_the_named_bo
 
 def test_cutting_trim_chip_reaches_the_remeshes_and_a_bad_label_is_refused_by_name(tmp_path):
     from wendel.cutting.fe import fe_scene
-    text = (ROOT / "workflows" / "cutting-ti6al4v-steady.toml").read_text()
-    assert "trim_chip" not in text
-    (tmp_path / "s.toml").write_text(text.replace("[cutting]\n", "[cutting]\ntrim_chip = 4.0\n", 1))
-    fe = fe_scene(load(tmp_path / "s.toml"))
+    assert fe_scene(load(ROOT / "workflows" / "cutting-aisi1045-steady.toml")).remesh.trim is None     # opt-in
+    fe = fe_scene(load(ROOT / "workflows" / "cutting-ti6al4v-steady.toml"))      # trim_chip = 4
     t = fe.remesh.trim
     assert t.label == "free_surface" and fe.remesh.zones_follow == "tool"
     assert t.radius == pytest.approx(4 * 0.1) and t.above == pytest.approx(t.point[1] + 1.05 * 0.1)   # mm

@@ -100,8 +100,7 @@ def remesh_state(inc_dir: Path, mesh_old: Path, ubase_old: np.ndarray | None, di
     (small strain: the new mesh is made from the original geometry); ``zones``: boxes of finer size
     (:func:`wendel.remesh.mesher.remesh`); ``smooth_features``: :mod:`wendel.remesh.features`; ``tool``: a 2D
     rigid tool where it stands (``vertices``, ``radii``): new boundary nodes inside it are moved onto its surface
-    (:mod:`wendel.remesh.snap`); ``trim``: material left out of the new mesh (2D, ``remesh.trim`` where it stands,
-    :func:`wendel.remesh.snap.trim_at`).
+    (:mod:`wendel.remesh.snap`); ``trim``: what the new mesh leaves out (:func:`wendel.remesh.snap.trim_at`).
     """
     from . import mesher, transfer
 
@@ -132,9 +131,8 @@ def remesh_state(inc_dir: Path, mesh_old: Path, ubase_old: np.ndarray | None, di
               "min_quality_before": before["min"], "inverted_before": before["inverted"],
               "min_quality_after": info["min_sicn"], "measure_old": info["measure_old"],
               "measure_new": info["measure_new"], "remesh_seconds": t1 - t0,
-              "boundary_nodes_smoothed": info.get("boundary_nodes_smoothed", 0),
-              **{k: info[k] for k in ("trimmed_elements", "trimmed_measure") if k in info}}
-    report.update(snapped)
+              "boundary_nodes_smoothed": info.get("boundary_nodes_smoothed", 0)}
+    report.update({**snapped, **{k: info[k] for k in ("trimmed_elements", "trimmed_measure") if k in info}})
     # Every field goes through one point location: nodal fields as they are, cell fields recovered
     # to nodes (volume-weighted, integral kept), all stacked, interpolated once, split again.
     utot = u + (ubase_old if ubase_old is not None else 0.0)
@@ -291,8 +289,7 @@ def maybe_remesh(scene, files, state, dimension: int, progress, again: int = 0, 
         axisymmetric=scene.elasticity.plane == "axisymmetric", zones=zones_at(r, files.fem / f"inc-{inc:04d}"),
         algorithm_2d=algorithm, smooth_features=r.smooth_features, make_mesh=limit.mesher(r.mesh_timeout),
         tool=tool_at(scene, files.fem / f"inc-{inc:04d}") if r.snap_to_tool else None,
-        trim=trim_at(r, files.fem / f"inc-{inc:04d}")), k, inc, lf, q, files.root,
-        tries, progress)
+        trim=trim_at(r, files.fem / f"inc-{inc:04d}")), k, inc, lf, q, files.root, tries, progress)
     rep.update({"remesh": k, "after_increment": inc, "load_factor": lf, "dimension": dimension,
                 "algorithm_2d_tries": again + used, "after_failed_step": failed,
                 "first_steps": first_steps(scene, lf, state.pending)})      # (drop_last_remesh takes them out)
