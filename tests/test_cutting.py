@@ -269,7 +269,7 @@ def test_chip_thickness_counts_the_first_layer_only_when_the_chip_curls_back_ove
     assert old > 1.9 * t2
     new, spread = chip.chip_thickness(nodes[free], [0.0, 0.0], rake, band, mesh=(nodes, tri))
     assert new == pytest.approx(t2, rel=1e-9) and spread < 1e-12
-    assert chip.first_layer_end(nodes, tri, [0.0, 0.0], rake, 150e-6) == pytest.approx(t2, rel=1e-9)
+    assert chip.first_layer_ends(nodes, tri, [0.0, 0.0], rake, [150e-6])[0] == pytest.approx(t2, rel=1e-9)
     alone, _ = chip.chip_thickness(chip_pts[np.isclose(chip_pts @ normal, t2)], [0.0, 0.0], rake, band,
                                    mesh=(chip_pts, chip_tri))
     assert alone == pytest.approx(t2, rel=1e-9)       # one layer: the same points as without the mesh

@@ -46,7 +46,7 @@ def chip_thickness(points: np.ndarray, rake_point: np.ndarray, rake: float, band
 
     With ``mesh = (nodes, triangles)`` (the deformed body), only the points of the chip's first layer count: a
     point further from the rake face than the end of the first stretch of material on the rake face's normal
-    through it (:func:`first_layer_end`) belongs to a part of the chip that has curled back over the band (its
+    through it (:func:`first_layer_ends`) belongs to a part of the chip that has curled back over the band (its
     inner or outer surface), not to the back surface; before session 33 such points doubled and tripled the
     median of a long titanium cut."""
     points = np.asarray(points, dtype=float)
@@ -56,8 +56,7 @@ def chip_thickness(points: np.ndarray, rake_point: np.ndarray, rake: float, band
     s, d = rel @ along, rel @ normal
     pick = (s >= band[0]) & (s <= band[1]) & (d > 0)
     if pick.any() and mesh is not None:
-        nodes, tri = mesh
-        ends = np.array([first_layer_end(nodes, tri, rake_point, rake, si) for si in s[pick]])
+        ends = first_layer_ends(*mesh, rake_point, rake, s[pick])
         keep = d[pick] <= ends * (1 + 1e-9) + 1e-12 * (abs(band[1]) + abs(band[0]))
         pick[np.flatnonzero(pick)[~keep]] = False
     if not pick.any():
@@ -65,45 +64,48 @@ def chip_thickness(points: np.ndarray, rake_point: np.ndarray, rake: float, band
     return float(np.median(d[pick])), float(d[pick].max() - d[pick].min())
 
 
-def first_layer_end(nodes: np.ndarray, triangles: np.ndarray, rake_point, rake: float, s: float) -> float:
+def first_layer_ends(nodes: np.ndarray, triangles: np.ndarray, rake_point, rake: float, s) -> np.ndarray:
     """Distance from the rake face line (through ``rake_point`` at ``rake`` [rad]) at which the first stretch of
-    material on its normal at ``s`` [m] up the face ends: the triangles the normal line crosses give intervals of
-    distance (d >= 0), merged where they touch; the end of the one nearest the face. ``inf`` where the line
-    crosses no triangle.
+    material on its normal at each ``s`` [m] up the face ends: the triangles the normal line crosses give intervals
+    of distance (d >= 0), merged where they touch; the end of the one nearest the face. ``inf`` where the line
+    crosses no triangle. The nodes are projected once for all ``s``.
 
     >>> nodes = np.array([[0.0, 0.0], [-1.0, 0.0], [-1.0, 2.0], [0.0, 2.0], [-2.0, 0.0], [-3.0, 0.0],
     ...                   [-3.0, 2.0], [-2.0, 2.0]])      # two strips beside a vertical rake face, a gap between
     >>> tri = np.array([[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]])
-    >>> first_layer_end(nodes, tri, [0.0, 0.0], 0.0, 1.0)
-    1.0
+    >>> first_layer_ends(nodes, tri, [0.0, 0.0], 0.0, [1.0, 3.0]).tolist()
+    [1.0, inf]
     """
-    nodes = np.asarray(nodes, dtype=float)
     along = np.array([math.sin(rake), math.cos(rake)])
     normal = np.array([-math.cos(rake), math.sin(rake)])
-    rel = nodes - np.asarray(rake_point, dtype=float)
-    u, v = rel @ along - s, rel @ normal            # the line is u = 0, v its distance from the face
+    rel = np.asarray(nodes, dtype=float)[:, :2] - np.asarray(rake_point, dtype=float)
+    u0, v = rel @ along, rel @ normal                # along the face, and the distance from it
     tri = np.asarray(triangles)
-    lo, hi = np.full(len(tri), np.inf), np.full(len(tri), -np.inf)
-    for a, b in ((0, 1), (1, 2), (2, 0)):
-        ua, ub, va, vb = u[tri[:, a]], u[tri[:, b]], v[tri[:, a]], v[tri[:, b]]
-        cross = (ua * ub <= 0) & (ua != ub)
-        t = np.divide(ua, ua - ub, out=np.zeros_like(ua), where=cross)
-        vc = va + t * (vb - va)
-        lo = np.where(cross, np.minimum(lo, vc), lo)
-        hi = np.where(cross, np.maximum(hi, vc), hi)
-    ok = (hi >= lo) & (hi > 0)
-    if not ok.any():
-        return math.inf
-    lo, hi = np.maximum(lo[ok], 0.0), hi[ok]
-    order = np.argsort(lo)
-    lo, hi = lo[order], hi[order]
+    edges = [(u0[tri[:, a]], u0[tri[:, b]], v[tri[:, a]], v[tri[:, b]]) for a, b in ((0, 1), (1, 2), (2, 0))]
     tol = 1e-9 * max(float(np.abs(v).max()), 1e-300)
-    end = hi[0]
-    for a, b in zip(lo[1:], hi[1:]):
-        if a > end + tol:
-            break
-        end = max(end, b)
-    return float(end)
+    out = []
+    for si in np.atleast_1d(np.asarray(s, dtype=float)):
+        lo, hi = np.full(len(tri), np.inf), np.full(len(tri), -np.inf)
+        for ua0, ub0, va, vb in edges:             # the line is u = s: where each edge crosses it
+            ua, ub = ua0 - si, ub0 - si
+            cross = (ua * ub <= 0) & (ua != ub)
+            t = np.divide(ua, ua - ub, out=np.zeros_like(ua), where=cross)
+            vc = va + t * (vb - va)
+            lo = np.where(cross, np.minimum(lo, vc), lo)
+            hi = np.where(cross, np.maximum(hi, vc), hi)
+        ok = (hi >= lo) & (hi > 0)
+        if not ok.any():
+            out.append(math.inf)
+            continue
+        order = np.argsort(np.maximum(lo[ok], 0.0))
+        lo_s, hi_s = np.maximum(lo[ok], 0.0)[order], hi[ok][order]
+        end = hi_s[0]
+        for a, b in zip(lo_s[1:], hi_s[1:]):
+            if a > end + tol:
+                break
+            end = max(end, b)
+        out.append(float(end))
+    return np.array(out)
 
 
 @dataclasses.dataclass(frozen=True)

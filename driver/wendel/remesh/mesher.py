@@ -285,11 +285,12 @@ def remesh(points_deformed, mesh_in_path, out_path, h, size_indicator=None, h_mi
                                  f"names ({', '.join(sorted(names))})")
             trimmed = (int((~keep).sum()), float(meas_old[~keep].sum()))
             cells = cells[keep]
-            inner = {tuple(sorted(f)) for f in boundary_facets(cells).tolist()} - \
-                {tuple(sorted(f)) for f in facets.tolist()}       # the cut's edges: boundary now, unlabelled
-            facets = np.vstack([facets, np.array(sorted(inner), dtype=facets.dtype).reshape(-1, 2)])
-            facet_tags = np.concatenate([facet_tags, np.full(len(inner), int(names[trim["label"]][0]))])
     bf = boundary_facets(cells)
+    if trimmed[0]:      # the cut's edges (boundary now, no old facet) get the trim's label
+        old = {tuple(sorted(f)) for f in facets.tolist()}
+        inner = np.array([f for f in bf.tolist() if tuple(sorted(f)) not in old], dtype=facets.dtype).reshape(-1, 2)
+        facets = np.vstack([facets, inner])
+        facet_tags = np.concatenate([facet_tags, np.full(len(inner), int(names[trim["label"]][0]))])
     labels = _label_facets(bf, facets, facet_tags)
     h_min = h / 4 if h_min is None else h_min
     smoothed = 0
@@ -406,7 +407,7 @@ def trim_cells(points, cells, point, radius: float, above: float) -> np.ndarray:
         return keep
     kept = np.flatnonzero(keep)
     body = bodies.body_index(cells[kept])
-    area = np.abs(quality.signed_measure(np.hstack([p, np.zeros((len(p), 1))]), cells[kept]))
+    area = np.abs(quality.signed_measure(p, cells[kept]))
     largest = np.argmax(np.bincount(body, weights=area))
     keep[kept[body != largest]] = False
     return keep
