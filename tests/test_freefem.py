@@ -55,3 +55,36 @@ def test_time_limit_stops_the_processes(tmp_path):
 def test_missing_entry_script(tmp_path):
     with pytest.raises(freefem.FreeFemError, match="no entry script"):
         freefem.run("solve-9d.edp", [], tmp_path)
+
+
+def test_work_beside_a_launch_runs_while_freefem_runs_and_its_failure_stops_it(tmp_path):
+    """``beside`` (the drilling loop starts its next launch there) runs once, after FreeFEM started and before
+    it ends; if it raises, the launch is stopped (no process left) and the error comes through."""
+    import subprocess
+
+    entry = tmp_path / "slow.edp"
+    # a file written at the start, then some work (0.5-1 s): `beside` sees the process alive
+    entry.write_text('{ ofstream f("started.txt"); f << 1 << endl; }\n'
+                     "real s = 0;\nfor (int i = 0; i < 3000000; ++i) s += 1;\n"
+                     '{ ofstream f("ended.txt"); f << s << endl; }\n')
+    seen = []
+
+    def beside():
+        out = tmp_path / "out"
+        seen.append((out / "ended.txt").exists())
+        left = subprocess.run(["pgrep", "-f", str(entry)], capture_output=True, text=True).stdout.split()
+        seen.append(bool(left))
+
+    freefem.run(str(entry), [], tmp_path / "out", beside=beside)
+    assert seen == [False, True]
+    assert (tmp_path / "out" / "ended.txt").is_file()
+
+    def fails():
+        raise RuntimeError("beside failed")
+
+    with pytest.raises(RuntimeError, match="beside failed"):
+        freefem.run(str(entry), [], tmp_path / "out2", beside=fails)
+    time.sleep(0.5)
+    left = subprocess.run(["pgrep", "-f", str(entry)], capture_output=True, text=True).stdout.strip()
+    assert left == ""
+    assert not (tmp_path / "out2" / "ended.txt").exists()

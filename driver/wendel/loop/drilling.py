@@ -358,9 +358,11 @@ class Process:
             # at nice 0 it slowed the solve on this shared machine: drilling-3d 10.8 -> 12.0 s), and is given the
             # driver's priority at its "go"; where the priority cannot be raised again, it starts after this
             # launch, while the driver accepts, removes and transfers (wendel.prestart)
-            self.ahead = self.start_next(inc0 + len(lfs), seg, scene_opts, early=True)
+            def early():
+                self.ahead = self.start_next(inc0 + len(lfs), seg, scene_opts, early=True)
+
             freefem.run(self.entry, opts, files.fem, ranks=work.numerics.ranks, timeout=work.numerics.timeout,
-                        log=files.root / "freefem.log", started=ahead)
+                        log=files.root / "freefem.log", started=ahead, beside=early)
             wall = time.perf_counter() - t0      # FreeFEM's end: the accept below is driver output (no double count)
             if self.ahead is None:
                 self.ahead = self.start_next(inc0 + len(lfs), seg, scene_opts)
