@@ -1,6 +1,8 @@
 """Benchmark ``overhead`` (issue 20): every second outside the solve, scene by scene.
 
-Each scene of workflows/ is run as its own ``python`` process (so Python's start-up and imports count), and
+Each scene of workflows/ is run as its own ``python`` process (so Python's start-up and imports count), as
+``wendel run`` runs it (``wendel.cli.main``: the picture process started before the driver's imports; a scene
+of :data:`SCALE` through ``wendel.loop.run`` with its h multiplied), and
 its phases are read from the run's summary.json (:func:`shares`): FreeFEM start-up (launch wall time minus
 FreeFEM's clock: process and MPI start, compiling the .edp, plugins), meshing (gmsh), FreeFEM file output
 (the fields, energies and record of each increment), FreeFEM set-up (FreeFEM's clock outside solve and
@@ -8,7 +10,8 @@ output: reading the mesh, building spaces and state), driver output (VTU, histor
 FreeFEM ends), remeshing and transfer, picture (the wait for the PNG) and Python (the process minus the
 run: interpreter start, imports, provenance). "solve" is assembly + linear solve + constitutive update;
 ``outside_process`` is the share of the whole process outside it, which :func:`goal` holds against issue
-20's goal.
+20's goal; ``without_startup`` and ``warm`` (:func:`bounds`) what it would be with no FreeFEM start, and with
+no Python start and imports either: the most that processes living across runs could give.
 
 ``--quick``: every scene at its smoke size. Otherwise each scene at its default size, except those of
 :data:`SCALE` (their default takes minutes on the shared 2-core machine): geometry.h multiplied as stated.
@@ -48,9 +51,11 @@ from pathlib import Path
 tree, scene, out, smoke, scale = sys.argv[1:6]
 if tree:
     sys.path.insert(0, str(Path(tree) / "driver"))
+if not scale:           # what a user runs: `wendel run SCENE --out DIR [--smoke]` (since session 34)
+    from wendel.cli import leave, main
+    leave(main(["run", scene, "--out", out] + (["--smoke"] if smoke == "1" else [])))
 from wendel.loop import run
-run(scene, smoke=smoke == "1", out=Path(out), progress=lambda *a: None,
-    scale=float(scale) if scale else None)
+run(scene, smoke=smoke == "1", out=Path(out), progress=lambda *a: None, scale=float(scale))
 try:                                      # the end of the wendel console script (a checkout that has it)
     from wendel.cli import leave
 except ImportError:
@@ -73,6 +78,9 @@ def run_once(scene: Path, out: Path, smoke: bool, scale: float | None, tree: Pat
     cmd = [sys.executable, "-c", _CHILD, str(tree or THIS), str(scene), str(out), "1" if smoke else "0",
            "" if scale is None or smoke else repr(scale)]
     load = os.getloadavg()[0]
+    import resource
+
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     try:
         proc = subprocess.run(cmd, capture_output=True, text=True, cwd=tree or THIS,
@@ -81,8 +89,12 @@ def run_once(scene: Path, out: Path, smoke: bool, scale: float | None, tree: Pat
         return {"scene": scene.stem, "size": "smoke" if smoke else "default", "tree": "base" if tree else "this",
                 "process_wall": time.perf_counter() - t0, "error": "timeout (WENDEL_BENCH_TIMEOUT)"}
     process = time.perf_counter() - t0
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    # CPU seconds of the run's process and of all it waited for (FreeFEM, the picture process)
+    cpu = after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime
     row = {"scene": scene.stem, "size": "smoke" if smoke else (f"h x{scale:g}" if scale else "default"),
-           "tree": "base" if tree else "this", "load_average": round(load, 1), "process_wall": process}
+           "tree": "base" if tree else "this", "load_average": round(load, 1), "process_wall": process,
+           "cpu": round(cpu, 3)}
     if proc.returncode != 0 or not (out / "summary.json").is_file():
         row["error"] = (proc.stderr.strip().splitlines() or ["?"])[-1][:200]
         return row
@@ -157,6 +169,21 @@ def goal(row: dict) -> str:
     return "–"
 
 
+def bounds(row: dict) -> dict:
+    """What the outside share would be with no process start to pay: ``without_startup`` with FreeFEM's
+    start-up phase at zero (a FreeFEM that takes launch after launch), ``warm`` with the Python column at
+    zero too (a process that imported the driver before the run, and such a FreeFEM). Lower bounds of those
+    levers: neither would make the other phases shorter.
+
+    >>> bounds({"process_wall": 10.0, "solve": 8.0, "startup": 0.5, "python": 0.5})
+    {'without_startup': 0.1579, 'warm': 0.1111}
+    """
+    wall, solve = row["process_wall"], row["solve"]
+    startup, python = row.get("startup", 0.0), row.get("python", 0.0)
+    return {"without_startup": round(1.0 - solve / (wall - startup), 4),
+            "warm": round(1.0 - solve / (wall - startup - python), 4)}
+
+
 def same_fingerprints(a: Path, b: Path) -> bool:
     """Whether two runs of a scene agree: increments, Newton iterations, launches aside, DoFs, and every
     number of each increment's record to 1e-9 (not the clocks and the linear iterations: FreeFEM counts them
@@ -196,11 +223,14 @@ def overhead(quick: bool, workdir: Path) -> list[dict]:
                 row["outside_process"] = 1.0 - row["solve"] / row["process_wall"]
                 row["python"] = max(row["process_wall"] - row["wall"], 0.0)
                 row["goal"] = goal(row)
+                row.update(bounds(row))
             if tree is None and base and which == "both" and "wall" in row and "wall" in rows[-1]:
                 row["same_as_base"] = same_fingerprints(workdir / scene.stem / "base", out)
             rows.append(row)
+            more = f" (no FreeFEM start {row['without_startup']:.0%}, warm {row['warm']:.0%})" if "warm" in row else ""
+            more += f", CPU {row['cpu']:.2f} s" if "cpu" in row else ""
             print(f"  {row['scene']} ({row['tree']}): {row['process_wall']:.2f} s, outside "
-                  f"{row.get('outside_process', float('nan')):.0%} {row.get('error', '')}", flush=True)
+                  f"{row.get('outside_process', float('nan')):.0%}{more} {row.get('error', '')}", flush=True)
     return rows
 
 
