@@ -103,6 +103,8 @@ def run_scene(scene: Scene, scene_path: Path, out: Path, smoke: bool = False, pr
         summary.write_provenance(files.root, Path(scene_path), scene, smoke, record)
         state = State(pending=scene.loading.load_factors())
         state.mesh_seconds, dimension = build(scene, files)
+        if dimension == 2:
+            pictures.plane()           # the picture process needs no matplotlib (wendel.results.flat)
         _save_checkpoint(files, scene, state, dimension)
         return _execute(scene, files, state, progress, until)
 

@@ -1,7 +1,8 @@
 """Pictures of a result: the deformed body (``deformed.png`` of a run), off-screen with pyvista
 (:func:`picture`) or with matplotlib (:func:`quick_picture`: 0.6 s to import and draw a small mesh where
-pyvista takes 3 s to import and open its first window). A run draws it in a :class:`Painter` process that
-starts with the run (:func:`renderer` chooses)."""
+pyvista takes 3 s to import and open its first window); a plane body with Pillow (:mod:`.flat`: 0.2 s to
+import, 0.03-0.07 s to draw). A run draws it in a :class:`Painter` process that starts with the run
+(:func:`renderer` chooses)."""
 
 from __future__ import annotations
 
@@ -9,6 +10,8 @@ import os
 from pathlib import Path
 
 import numpy as np
+
+from .quick import quick_picture      # the matplotlib renderer (solids, z = u surfaces)
 
 
 def picture(vtu: Path, png: Path, title: str, warp: float = 0.0, field: str | None = None,
@@ -50,95 +53,6 @@ def picture(vtu: Path, png: Path, title: str, warp: float = 0.0, field: str | No
         plotter.view_isometric()
     plotter.screenshot(png)
     plotter.close()
-
-
-def _faces(tets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The boundary triangles of a tetrahedral mesh (faces of one tetrahedron only) and their tetrahedra.
-
-    >>> f, owner = _faces(np.array([[0, 1, 2, 3], [1, 2, 3, 4]])); len(f), sorted(owner.tolist())
-    (6, [0, 0, 0, 1, 1, 1])
-    """
-    local = np.array([[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]])
-    faces = tets[:, local].reshape(-1, 3)
-    owner = np.repeat(np.arange(len(tets)), 4)
-    _, first, counts = np.unique(np.sort(faces, axis=1), axis=0, return_index=True, return_counts=True)
-    keep = first[counts == 1]
-    return faces[keep], owner[keep]
-
-
-def quick_picture(vtu: Path, png: Path, title: str, warp: float = 0.0, field: str | None = None,
-                  deformed: bool = False) -> None:
-    """The deformed body drawn with matplotlib (0.6 s to start here, against 3 s for pyvista): a plane body
-    as coloured triangles, a solid as its coloured boundary faces, a scalar ``u`` on a plane as the surface
-    z = u; coloured by ``field`` (von Mises by default) and scaled as :func:`picture` does (``deformed``: the
-    points are the current configuration already, as in updated-Lagrangian runs)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    import meshio
-    from matplotlib.tri import Triangulation
-
-    m = meshio.read(vtu)
-    points = np.asarray(m.points, dtype=float)
-    u = np.asarray(m.point_data["u"]) if "u" in m.point_data else np.zeros((len(points), 3))
-    solid = any(b.type == "tetra" for b in m.cells)
-    kind = "tetra" if solid else "triangle"
-    cells = np.concatenate([b.data for b in m.cells if b.type == kind])
-    field = field or ("vonMises" if "vonMises" in m.cell_data else None)
-    values = np.concatenate([np.ravel(v) for v in m.cell_data[field]]) if field else None
-    size = max(np.ptp(points, axis=0))
-    fig = plt.figure(figsize=(9, 7), dpi=100)
-    if u.ndim == 1 or solid:
-        if u.ndim == 1:         # a scalar field on a plane (membrane, torsion): the surface z = u
-            scale = warp or (0.3 * size / (float(np.abs(u).max()) or 1.0))
-            xyz = points.copy()
-            xyz[:, 2] = scale * u
-            faces, owner = cells, np.arange(len(cells))
-            field = field or "u"
-            values = values if values is not None else u[cells].mean(axis=1)
-            what = f"u x{scale:.3g} upwards"
-        else:
-            umax = float(np.abs(u).max()) or 1.0
-            scale = warp or (1.0 if umax >= 0.05 * size or "u_total" in m.point_data else 0.1 * size / umax)
-            scale = 0.0 if deformed else scale
-            xyz = points + scale * u[:, :3]
-            faces, owner = _faces(cells)
-            what = "current configuration" if deformed else f"displacement x{scale:.3g}"
-        from mpl_toolkits.mplot3d.art3d import Poly3DCollection
-
-        ax = fig.add_subplot(projection="3d")
-        colours = values[owner] if values is not None else np.zeros(len(faces))
-        norm = plt.Normalize(colours.min(), colours.max())
-        poly = Poly3DCollection(xyz[faces], facecolors=plt.cm.viridis(norm(colours)),
-                                edgecolors="k" if len(faces) < 20000 else "none", linewidths=0.1)
-        ax.add_collection3d(poly)
-        lo, hi = xyz.min(axis=0), xyz.max(axis=0)
-        ax.set_xlim(lo[0], hi[0]), ax.set_ylim(lo[1], hi[1]), ax.set_zlim(lo[2], hi[2])
-        ax.set_box_aspect(np.maximum(hi - lo, 1e-3 * max(hi - lo)))
-        ax.view_init(elev=30, azim=-60)
-        mappable = plt.cm.ScalarMappable(norm=norm, cmap="viridis")
-        fig.colorbar(mappable, ax=ax, label=field or "", shrink=0.7)
-        ax.set_title(f"{title} ({what})", fontsize=10)
-    else:
-        u = u[:, :2]
-        umax = float(np.abs(u).max()) or 1.0
-        large = umax >= 0.05 * size or "u_total" in m.point_data
-        scale = 0.0 if deformed else warp or (1.0 if large else 0.1 * size / umax)
-        p = points[:, :2] + scale * u
-        ax = fig.add_subplot()
-        style = {"edgecolors": "k", "linewidth": 0.2} if len(cells) < 20000 else {}
-        tri = Triangulation(p[:, 0], p[:, 1], cells)
-        if values is not None:
-            mesh = ax.tripcolor(tri, facecolors=values, cmap="viridis", **style)
-            fig.colorbar(mesh, ax=ax, label=field)
-        else:
-            ax.triplot(tri, color="k", linewidth=0.3)
-        ax.set_aspect("equal")
-        ax.set_title(f"{title} ({'current configuration' if deformed else f'displacement x{scale:.3g}'})",
-                     fontsize=10)
-    fig.savefig(png)
-    plt.close(fig)
 
 
 BIG_MESH = 5e6
@@ -193,6 +107,15 @@ class Painter:
         if answer != "ok":
             raise RuntimeError(f"picture {png}: {answer or 'picture process ended'}")
 
+    def plane(self) -> None:
+        """Tell the process that the run's body is plane (2D or (r, z)): its pictures are drawn with Pillow, and
+        matplotlib, imported beside the run for solids, is left (0.7-0.9 s of CPU on a 2-core machine)."""
+        try:
+            self.proc.stdin.write('{"hint": "plane"}\n')
+            self.proc.stdin.flush()
+        except OSError:         # it ended: the picture says so
+            pass
+
     def close(self, at_once: bool = False) -> None:
         """End the process: it ends by itself when its stdin closes (after its start if it is still
         starting); killed after 5 s, or ``at_once`` (the run stopped short)."""
@@ -224,6 +147,12 @@ def prestart(renderer: str = "matplotlib") -> None:
         _EARLY.append(Painter(renderer))
 
 
+def plane() -> None:
+    """The run's body is plane: tell the picture process :func:`prestart` started (if any)."""
+    for early in _EARLY:
+        early.plane()
+
+
 def painter(renderer: str) -> Painter:
     """A picture process for ``renderer``: the one :func:`prestart` started if it is alive and the same
     renderer (else it is stopped), or a new one."""
@@ -237,23 +166,44 @@ def painter(renderer: str) -> Painter:
 
 def serve_lines(renderer: str, stdin, stdout) -> None:
     """Warm up (import, one off-screen render), then one picture per request line of ``stdin``, answered on
-    ``stdout``, until ``stdin`` closes."""
+    ``stdout``, until ``stdin`` closes. ``matplotlib``: plane bodies are drawn with Pillow
+    (:mod:`wendel.results.flat`), the rest with matplotlib, imported in a thread unless a ``{"hint": "plane"}``
+    line came first (:meth:`Painter.plane`)."""
+    import importlib
     import json
+    import sys
+    import threading
 
     if renderer == "matplotlib":
-        import matplotlib
+        import meshio
 
-        matplotlib.use("Agg")
-        import matplotlib.pyplot  # noqa: F401 - warm-up
-        import meshio  # noqa: F401
+        from . import flat     # a plane body: Pillow (numpy and Pillow 0.2 s to import, matplotlib 0.7-0.9 s)
 
-        draw = quick_picture
+        plane = threading.Event()       # the driver's "plane" line: no matplotlib needed
+
+        def _matplotlib():          # solids and z = u surfaces: matplotlib, imported beside the run
+            for name in ("matplotlib", "matplotlib.pyplot", "matplotlib.tri"):
+                if plane.is_set():
+                    return
+                importlib.import_module(name)
+                if name == "matplotlib":
+                    sys.modules["matplotlib"].use("Agg")
+
+        threading.Thread(target=_matplotlib, daemon=True).start()
+
+        def draw(vtu, png, title, warp, deformed=False):
+            if not flat.plane_picture(meshio.read(vtu), png, title, warp, deformed=deformed):
+                quick_picture(vtu, png, title, warp, deformed=deformed)
     else:
         _warm_up()
         draw = picture
     for line in stdin:
         try:
             req = json.loads(line)
+            if req.get("hint") == "plane":          # Painter.plane: answered by nothing
+                if renderer == "matplotlib":
+                    plane.set()
+                continue
             draw(Path(req["vtu"]), Path(req["png"]), req["title"], req["warp"], deformed=req.get("deformed", False))
             answer = "ok"
         except Exception as exc:        # noqa: BLE001 - reported to the driver, which raises it
