@@ -64,3 +64,17 @@ def test_a_process_told_plane_draws_without_matplotlib_and_still_draws_a_solid(t
     lines = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120).stdout.splitlines()
     assert lines == ["['ok'] False", "['ok', 'ok'] True"], lines
     assert (tmp_path / "plane.png").stat().st_size > 10000 and (tmp_path / "solid.png").stat().st_size > 10000
+
+
+def test_cells_of_other_kinds_in_the_file_do_not_shift_the_colours(tmp_path):
+    """A VTU with boundary lines before the triangles (their own cell values): each triangle keeps its value."""
+    pts = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0.5, 0.5, 0]], float)
+    mesh = meshio.Mesh(pts, [("line", np.array([[0, 1], [1, 2]])),
+                             ("triangle", np.array([[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]]))],
+                       point_data={"u": np.zeros((5, 3))},
+                       cell_data={"vonMises": [np.array([100.0, 100.0]), np.array([1.0, 2.0, 3.0, 4.0])]})
+    png = tmp_path / "a.png"
+    assert flat.plane_picture(mesh, png, "x")
+    img = np.asarray(Image.open(png).convert("RGB")).reshape(-1, 3)
+    for rgb in flat.colours(np.array([1.0, 2.0, 3.0, 4.0]), 1.0, 4.0):
+        assert np.all(img == rgb, axis=1).sum() > 50000

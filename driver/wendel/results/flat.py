@@ -151,7 +151,8 @@ def plane_picture(mesh, png: Path, title: str, warp: float = 0.0, field: str | N
         return False
     cells = np.concatenate([b.data for b in mesh.cells if b.type == "triangle"])
     field = field or ("vonMises" if "vonMises" in mesh.cell_data else None)
-    values = np.concatenate([np.ravel(v) for v in mesh.cell_data[field]]).astype(float) if field else None
+    values = np.concatenate([np.ravel(v) for b, v in zip(mesh.cells, mesh.cell_data[field])
+                             if b.type == "triangle"]).astype(float) if field else None
     size = max(np.ptp(points, axis=0))
     u = u[:, :2]
     umax = float(np.abs(u).max()) or 1.0
