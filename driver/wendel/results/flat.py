@@ -98,15 +98,18 @@ def draw(points: np.ndarray, cells: np.ndarray, values: np.ndarray | None, title
     origin = np.array([box[0] + 0.5 * (box[2] - box[0] - used[0]), box[3] - 0.5 * (box[3] - box[1] - used[1])])
     xy = np.column_stack([origin[0] + (points[:, 0] - lo[0]) * scale, origin[1] - (points[:, 1] - lo[1]) * scale])
     tri = xy[cells]
-    edge = (0, 0, 0) if len(cells) < EDGES_BELOW else None
     if values is not None:
         vmin, vmax = float(np.nanmin(values)), float(np.nanmax(values))
-        fill = [tuple(c) for c in colours(values, vmin, vmax).tolist()]
+        rgb = colours(values, vmin, vmax)
+        fill = [tuple(c) for c in rgb.tolist()]
+        # edges a darker shade of their cell's colour: a fine graded region keeps its colour (black lines
+        # would cover it), as matplotlib's thin anti-aliased edges do
+        edges = [tuple(c) for c in (0.45 * rgb).astype(np.uint8).tolist()] if len(cells) < EDGES_BELOW \
+            else [None] * len(cells)
     else:
-        fill = [None] * len(cells)
-        edge = (0, 0, 0)
-    for corners, f in zip(tri.round(1).tolist(), fill):
-        pen.polygon([tuple(p) for p in corners], fill=f, outline=edge)
+        fill, edges = [None] * len(cells), [(0, 0, 0)] * len(cells)
+    for corners, f, e in zip(tri.round(1).tolist(), fill, edges):
+        pen.polygon([tuple(p) for p in corners], fill=f, outline=e)
     # the extent of the body on both axes: a frame with round values
     x0, y1, x1, y0 = origin[0], origin[1], origin[0] + used[0], origin[1] - used[1]
     pen.rectangle([x0 - 4 * s, y0 - 4 * s, x1 + 4 * s, y1 + 4 * s], outline=(90, 90, 90), width=s)
