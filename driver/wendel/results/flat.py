@@ -144,6 +144,20 @@ def _colour_bar(pen, s: int, vmin: float, vmax: float, label: str, font, small) 
     pen.text(((left + right) / 2, top - 14 * s), label, fill=(0, 0, 0), font=font, anchor="md")
 
 
+def warp_scale(u, size: float, warp: float, deformed: bool, total: bool) -> float:
+    """The factor the displacement ``u`` is drawn with on a body of ``size``: ``warp`` if given; true scale (1)
+    for a visible deformation or a remeshed body (``total``: its mesh is the deformed body already), else
+    magnified to a tenth of the size; 0 when the points are the current configuration (``deformed``).
+
+    >>> warp_scale(np.array([[0.001, 0.0]]), 1.0, 0.0, False, False), warp_scale(np.array([[0.1, 0.0]]), 1.0, 0.0, False, False)
+    (100.0, 1.0)
+    """
+    if deformed:
+        return 0.0
+    umax = float(np.abs(u).max()) or 1.0
+    return warp or (1.0 if umax >= 0.05 * size or total else 0.1 * size / umax)
+
+
 def plane_picture(mesh, png: Path, title: str, warp: float = 0.0, field: str | None = None,
                   deformed: bool = False) -> bool:
     """Draw ``mesh`` (a meshio mesh read from a run's VTU) if it is a plane body with a vector displacement
@@ -156,11 +170,8 @@ def plane_picture(mesh, png: Path, title: str, warp: float = 0.0, field: str | N
     field = field or ("vonMises" if "vonMises" in mesh.cell_data else None)
     values = np.concatenate([np.ravel(v) for b, v in zip(mesh.cells, mesh.cell_data[field])
                              if b.type == "triangle"]).astype(float) if field else None
-    size = max(np.ptp(points, axis=0))
     u = u[:, :2]
-    umax = float(np.abs(u).max()) or 1.0
-    large = umax >= 0.05 * size or "u_total" in mesh.point_data
-    scale = 0.0 if deformed else warp or (1.0 if large else 0.1 * size / umax)
+    scale = warp_scale(u, max(np.ptp(points, axis=0)), warp, deformed, "u_total" in mesh.point_data)
     what = "current configuration" if deformed else f"displacement x{scale:.3g}"
     draw(points[:, :2] + scale * u, cells, values, f"{title} ({what})", field or "", png)
     return True

@@ -11,7 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .quick import quick_picture      # the matplotlib renderer (solids, z = u surfaces)
+from .flat import warp_scale
+from .quick import quick_picture      # Pillow for plane bodies, matplotlib for solids and z = u surfaces
 
 
 def picture(vtu: Path, png: Path, title: str, warp: float = 0.0, field: str | None = None,
@@ -31,15 +32,10 @@ def picture(vtu: Path, png: Path, title: str, warp: float = 0.0, field: str | No
         field = field or "u"
         title = f"{title} (u x{scale:.3g} upwards)"
     elif "u" in grid.point_data:
-        u = grid.point_data["u"]
-        size = max(np.ptp(grid.points, axis=0))
-        umax = float(np.abs(u).max()) or 1.0
-        # true scale for visible deformations and remeshed bodies (their mesh is already the deformed
-        # body), magnified to 10% of the size for small ones
-        large = umax >= 0.05 * size or "u_total" in grid.point_data
-        scale = warp or (1.0 if large else 0.1 * size / umax)
-        if deformed:
-            scale = 0.0         # updated-Lagrangian VTU: the points are the deformed body already
+        # true scale for visible deformations and remeshed bodies, magnified to 10 % of the size for small
+        # ones, none for an updated-Lagrangian VTU (its points are the deformed body already)
+        scale = warp_scale(np.asarray(grid.point_data["u"]), max(np.ptp(grid.points, axis=0)), warp, deformed,
+                           "u_total" in grid.point_data)
         grid = grid.warp_by_vector("u", factor=scale)
         title = f"{title} ({'current configuration' if deformed else f'displacement x{scale:.3g}'})"
     field = field or ("vonMises" if "vonMises" in grid.cell_data else None)
@@ -175,14 +171,12 @@ def serve_lines(renderer: str, stdin, stdout) -> None:
     import threading
 
     if renderer == "matplotlib":
-        import meshio
-
-        from . import flat     # a plane body: Pillow (numpy and Pillow 0.2 s to import, matplotlib 0.7-0.9 s)
+        import meshio  # noqa: F401 - warm-up (numpy and Pillow 0.2 s to import, matplotlib 0.7-0.9 s)
 
         plane = threading.Event()       # the driver's "plane" line: no matplotlib needed
 
         def _matplotlib():          # solids and z = u surfaces: matplotlib, imported beside the run
-            for name in ("matplotlib", "matplotlib.pyplot", "matplotlib.tri"):
+            for name in ("matplotlib", "matplotlib.pyplot", "mpl_toolkits.mplot3d.art3d"):
                 if plane.is_set():
                     return
                 importlib.import_module(name)
@@ -190,10 +184,7 @@ def serve_lines(renderer: str, stdin, stdout) -> None:
                     sys.modules["matplotlib"].use("Agg")
 
         threading.Thread(target=_matplotlib, daemon=True).start()
-
-        def draw(vtu, png, title, warp, deformed=False):
-            if not flat.plane_picture(meshio.read(vtu), png, title, warp, deformed=deformed):
-                quick_picture(vtu, png, title, warp, deformed=deformed)
+        draw = quick_picture
     else:
         _warm_up()
         draw = picture
